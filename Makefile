@@ -1,0 +1,36 @@
+# make          build everything with -O2 (override: make CC=clang CFLAGS=-O3)
+# make test     the test suite; ends with "N passed, N failed"
+# make bench    time against error, printed as a table and plotted to bench/out/
+# make golf     the code-golf leaderboard (see golf/)
+# make clean
+CC     ?= cc
+CFLAGS ?= -O2
+LDLIBS  = -lm
+# OpenMP when the compiler has it (gcc, clang with libomp); ray.c builds without.
+OMP    := $(shell echo 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
+
+PROGS = ray minray tools/ppmdiff
+
+all: $(PROGS)
+
+ray: ray.c kdtree.c kdtree.h
+	$(CC) $(CFLAGS) $(OMP) -o $@ ray.c kdtree.c $(LDLIBS)
+
+# The card is K&R C with implicit int: -w keeps its historical text quiet.
+minray: minray.c
+	$(CC) $(CFLAGS) -w -o $@ minray.c $(LDLIBS)
+
+tools/ppmdiff: tools/ppmdiff.c
+	$(CC) $(CFLAGS) -o $@ tools/ppmdiff.c $(LDLIBS)
+
+test: all
+	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/run.sh
+
+bench: all
+	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash bench/run.sh
+
+clean:
+	rm -rf $(PROGS) build bench/out
+
+.PHONY: all test bench clean golf
+-include golf/golf.mk

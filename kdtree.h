@@ -1,0 +1,69 @@
+/* kdtree.h - a kd-tree over primitives it knows only through callbacks.
+ *
+ * The tree never sees a sphere or a triangle: the caller describes its
+ * primitives with three callbacks (a bounding box, an optional clip to a box,
+ * a ray intersection) and the tree answers "which primitive does this ray hit
+ * first" and "does anything block this ray".  See kdtree.c for the build
+ * (surface area heuristic, O(N log N), Wald & Havran 2006) and the traversal
+ * (Kaplan's near/far order, 1985).
+ *
+ * Usage:
+ *     kd_prims p = { my_bounds, my_clip_or_NULL, my_hit, my_scene };
+ *     kd_tree *t = kd_build(n, &p);
+ *     double tmax = INFINITY;
+ *     int i = kd_nearest(t, &p, org, dir, &my_ray, 0.0, &tmax, &counters);
+ *     ... i < 0 means no hit; otherwise primitive i at distance tmax ...
+ *     kd_free(t);
+ */
+#ifndef KDTREE_H
+#define KDTREE_H
+#include <stddef.h>
+
+typedef struct {
+    /* The axis-aligned box of primitive i. */
+    void (*bounds)(void *user, int i, double lo[3], double hi[3]);
+    /* Optional (NULL: use bounds). The box of the part of primitive i that
+     * lies inside [blo,bhi]; returns 0 when nothing of it is inside.  Lets the
+     * build make "perfect splits" (Havran 2000) for long thin primitives. */
+    int (*clip)(void *user, int i, const double blo[3], const double bhi[3],
+                double lo[3], double hi[3]);
+    /* Intersect primitive i with the caller's ray (passed through untouched
+     * as `ray`).  Returns 1 and sets *t when it hits at tmin < *t <= tmax. */
+    int (*hit)(void *user, int i, const void *ray, double tmin, double tmax,
+               double *t);
+    void *user;
+} kd_prims;
+
+typedef struct kd_tree kd_tree;
+
+/* Per-ray work, for --stats; either pointer argument below may be NULL. */
+typedef struct { unsigned long long rays, steps, tests; } kd_counters;
+
+/* Shape of a built tree, for --stats. */
+typedef struct {
+    long nodes, leaves, empty_leaves, max_depth, prim_refs;
+    double prims_per_leaf;  /* mean over non-empty leaves */
+    size_t bytes;           /* nodes plus primitive-index lists */
+    double sah_cost;        /* expected cost of a random ray, SAH model */
+    double build_seconds;
+} kd_info;
+
+/* Build over primitives 0..n-1 (n may be 0).  Returns NULL only when out of
+ * memory.  The build is deterministic: same input, same tree. */
+kd_tree *kd_build(int n, const kd_prims *p);
+
+/* Nearest hit of the ray org + t*dir with tmin < t <= *tmax.  Returns the
+ * primitive (ties in t go to the lower index, as a brute-force loop would)
+ * and stores its t in *tmax; returns -1 and leaves *tmax alone on a miss. */
+int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
+               const double dir[3], const void *ray, double tmin,
+               double *tmax, kd_counters *c);
+
+/* 1 when any primitive is hit with tmin < t <= tmax: for shadow rays. */
+int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
+           const double dir[3], const void *ray, double tmin, double tmax,
+           kd_counters *c);
+
+void kd_describe(const kd_tree *t, kd_info *info);
+void kd_free(kd_tree *t);
+#endif

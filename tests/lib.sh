@@ -1,0 +1,10 @@
+# Shared helpers for tests/*.test.sh (sourced, not run).
+# ok NAME / bad NAME print the line tests/run.sh counts; check NAME CMD... runs
+# CMD and reports PASS when it exits 0.
+ok()  { echo "PASS $*"; }
+bad() { echo "FAIL $*"; }
+check() { local name=$1; shift; if "$@" >/dev/null 2>&1; then ok "$name"; else bad "$name"; fi; }
+CC=${CC:-cc}
+CFLAGS=${CFLAGS:--O2}
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
+trap 'rm -rf "$TMP"' EXIT
