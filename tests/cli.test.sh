@@ -1,0 +1,60 @@
+# The command line and bad input: every error is "file:line: message", a
+# non-zero exit, and no image file (nor its .tmp) left behind.
+. tests/lib.sh
+good='0 6 .5  1 1 1  .9 .05 .2 .85 0 1.7'
+# bad_scene NAME PATTERN CONTENT: the scene CONTENT must fail with PATTERN.
+bad_scene() {
+  local name=$1 pat=$2
+  printf '%b' "$3" > "$TMP/s.sph"
+  rm -f "$TMP/out.ppm"
+  ./ray -o "$TMP/out.ppm" "$TMP/s.sph" 2> "$TMP/err"; rc=$?
+  if [ $rc -ne 0 ] && grep -qE "^$TMP/s.sph:[0-9]+: $pat" "$TMP/err" && ! ls "$TMP"/out.ppm* >/dev/null 2>&1; then
+    ok "$name: $(head -1 "$TMP/err" | sed "s|$TMP/||")"
+  else
+    bad "$name: exit $rc, said: $(head -1 "$TMP/err")"
+  fi
+}
+bad_scene "wrong number of fields" "a sphere needs 12 numbers, found 11" "$good\n1 2 3 1 1 1 1 0 0 0 0\n"
+bad_scene "text that is not a number" "not a number: 0\.5x" "# c\n0 6 0.5x 1 1 1 .9 .05 .2 .85 0 1.7\n"
+bad_scene "NaN" "number must be finite: nan" "0 6 nan 1 1 1 .9 .05 .2 .85 0 1.7\n"
+bad_scene "inf" "number must be finite: inf" "0 6 1 1 1 1 inf .05 .2 .85 0 1.7\n"
+bad_scene "huge number overflows to inf" "number must be finite: 1e999" "0 6 1 1 1 1 1e999 .05 .2 .85 0 1.7\n"
+bad_scene "negative radius" "sphere radius must be positive: -0\.9" "$good\n0 6 .5 1 1 1 -0.9 .05 .2 .85 0 1.7\n"
+bad_scene "absurd image size" "image size must be" "size 100000 100000\n$good\n"
+bad_scene "zero image size" "image size must be" "size 0 32\n$good\n"
+bad_scene "fractional image size" "image size must be" "size 32.5 32\n$good\n"
+bad_scene "unknown keyword" "unknown keyword: sphre" "sphre 1 2 3\n"
+bad_scene "keyword with too few numbers" "camera needs 10 numbers, found 3" "camera 0 0 0\n"
+bad_scene "camera looking at its eye" "camera looks at its own eye" "camera 1 1 1 1 1 1 0 0 1 40\n"
+bad_scene "error on the right line" "" "# one\n\n$good\n$good x\n"
+grep -q ":4: " "$TMP/err" && ok "the line number counts comments and blank lines" || bad "wrong line number: $(cat "$TMP/err")"
+
+rm -f "$TMP/out.ppm"
+./ray -o "$TMP/out.ppm" "$TMP/missing.sph" 2> "$TMP/err"; rc=$?
+[ $rc -ne 0 ] && grep -qE "^$TMP/missing.sph:0: cannot open scene: No such file" "$TMP/err" && [ ! -e "$TMP/out.ppm" ] \
+  && ok "missing file: $(sed "s|$TMP/||" "$TMP/err")" || bad "missing file: exit $rc, said: $(cat "$TMP/err")"
+
+printf '%s\n' "$good" > "$TMP/s.sph"
+for args in "-s 0x10" "-s 40000x10" "-s 10" "-s axb" "-n 0" "-n x" "-d -1" "-t 0" "--bogus"; do
+  ./ray $args -o "$TMP/out.ppm" "$TMP/s.sph" 2> "$TMP/err"; rc=$?
+  [ $rc -ne 0 ] && [ -s "$TMP/err" ] && [ ! -e "$TMP/out.ppm" ] && ok "bad option $args: $(head -1 "$TMP/err")" \
+    || bad "bad option $args: exit $rc"
+done
+./ray -o "$TMP/no/such/dir/out.ppm" "$TMP/s.sph" 2> "$TMP/err"; rc=$?
+[ $rc -ne 0 ] && grep -q "cannot write" "$TMP/err" && ok "unwritable output: $(head -1 "$TMP/err" | sed "s|$TMP/||")" \
+  || bad "unwritable output: exit $rc"
+./ray --help | grep -q "usage: ray" && ok "--help prints usage" || bad "--help"
+./ray 2> /dev/null; [ $? -eq 2 ] && ok "no scene: usage and exit 2" || bad "no scene"
+
+# Output forms: P6 by default, P3 on request, stdout with -o -, default name.
+./ray -s 7x5 -o "$TMP/a.ppm" scenes/minray.sph && [ "$(head -c 11 "$TMP/a.ppm")" = "$(printf 'P6\n7 5\n255')" ] \
+  && [ "$(wc -c < "$TMP/a.ppm")" = $((11 + 7 * 5 * 3)) ] && ok "P6 header and size" || bad "P6 output"
+./ray --p3 -s 7x5 -o - scenes/minray.sph | head -1 | grep -qx P3 && ok "--p3 to stdout" || bad "--p3 to stdout"
+(cd "$TMP" && "$OLDPWD/ray" -s 4x4 "$OLDPWD/scenes/minray.sph") && [ -s "$TMP/minray.ppm" ] \
+  && ok "default output name is the scene's base name" || bad "default output name"
+./ray -s 8x8 --stats -o "$TMP/a.ppm" scenes/minray.sph 2> "$TMP/err"
+grep -q "^rays .*primary.*shadow.*reflected.*refracted" "$TMP/err" && grep -q "^time " "$TMP/err" \
+  && ok "--stats prints rays by kind and time" || bad "--stats: $(cat "$TMP/err")"
+# No NaN: a scene whose glass has index 1 and sits at the eye still gives bytes.
+printf 'camera 0 0 0 0 1 0 0 0 1 60\n0 0 0 1 1 1 1 0 .5 .5 0 1\nlight 0 -5 5 1 1 1\n' > "$TMP/in.sph"
+./ray -s 16x16 -o "$TMP/in.ppm" "$TMP/in.sph" && ok "eye inside a sphere renders" || bad "eye inside a sphere"
