@@ -13,8 +13,8 @@ PROGS = ray minray tools/ppmdiff
 
 all: $(PROGS)
 
-ray: ray.c
-	$(CC) $(CFLAGS) $(OMP) -o $@ ray.c $(LDLIBS)
+ray: ray.c kdtree.c kdtree.h
+	$(CC) $(CFLAGS) $(OMP) -o $@ ray.c kdtree.c $(LDLIBS)
 
 # The card is K&R C with implicit int: -w keeps its historical text quiet.
 minray: minray.c

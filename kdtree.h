@@ -28,7 +28,11 @@ typedef struct {
     int (*clip)(void *user, int i, const double blo[3], const double bhi[3],
                 double lo[3], double hi[3]);
     /* Intersect primitive i with the caller's ray (passed through untouched
-     * as `ray`).  Returns 1 and sets *t when it hits at tmin < *t <= tmax. */
+     * as `ray`).  Returns 1 and sets *t when it hits at tmin < *t <= tmax.
+     * The tree finds exactly what a loop over all primitives finds as long
+     * as the point org + t*dir of a reported hit lies in the primitive's box
+     * (its clipped box, with clip), give or take a margin of 1e-9 times the
+     * largest coordinate of the scene and the ray origin. */
     int (*hit)(void *user, int i, const void *ray, double tmin, double tmax,
                double *t);
     void *user;
@@ -49,7 +53,9 @@ typedef struct {
 } kd_info;
 
 /* Build over primitives 0..n-1 (n may be 0).  Returns NULL only when out of
- * memory.  The build is deterministic: same input, same tree. */
+ * memory (or past 2^30 nodes or primitive references).  The build is
+ * deterministic: same input, same tree.  Boxes are kept in float; a
+ * primitive whose box is NaN or has lo > hi is left out. */
 kd_tree *kd_build(int n, const kd_prims *p);
 
 /* Nearest hit of the ray org + t*dir with tmin < t <= *tmax.  Returns the
@@ -66,4 +72,12 @@ int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
 
 void kd_describe(const kd_tree *t, kd_info *info);
 void kd_free(kd_tree *t);
+
+/* For tests and for the curious.  kd_bytes: the built tree as one block of
+ * bytes (the 8-byte nodes, then the leaves' lists of primitive numbers);
+ * two builds of the same input give equal blocks.  kd_splits: the axis
+ * (0, 1, 2) and position of each inner node's plane, in node order; writes
+ * at most max pairs and returns the number of inner nodes. */
+const void *kd_bytes(const kd_tree *t, size_t *size);
+long kd_splits(const kd_tree *t, int *axis, double *pos, long max);
 #endif

@@ -4,13 +4,17 @@
  *
  * Usage: ./ray [options] SCENE
  *     -o FILE     output image (default: SCENE's base name with .ppm; - = stdout)
- *     -s WxH      image size (default: the scene's `size`, else 512x512)
+ *     -s WxH      image size (default: the scene's, else 512x512)
  *     -n N        anti-aliasing samples per pixel (default 1)
  *     -d N        recursion depth; 1 = primary rays only (default: scene's, else 5)
  *     -t N        threads (default: every core, when built with OpenMP)
  *     --p3        plain-text PPM (P3) instead of binary (P6)
- *     --stats     print rays by kind, hits and time on stderr
+ *     --accel A   kd (the kd-tree of kdtree.c), none (test every object), or
+ *                 auto (default: the tree once there are 16 objects or more)
+ *     --stats     print rays by kind, hits, the tree and time on stderr
  *     --help
+ * SCENE is the sphere format (README.md), or an NFF file (Eric Haines'
+ * Neutral File Format, as the SPD benchmark scenes come) when it ends .nff.
  *
  * The program is the lecture's pseudo-code, top to bottom:
  *
@@ -28,8 +32,9 @@
  *             refracted ray (Snell)            colour += RayTrace(Refr)
  *
  * Its shading model is Heckbert's business card (minray.c) exactly, so
- * `./ray -o x.ppm scenes/minray.sph` prints minray's pixels.  The scene format
- * is described in README.md ("The sphere format").
+ * `./ray -o x.ppm scenes/minray.sph` prints minray's pixels.  Spheres and
+ * triangles are the primitives; nearest_hit() asks the kd-tree (kdtree.c)
+ * once a scene is large enough to gain from one.
  *
  * Build options: -DREAL=float makes every vector float instead of double
  * (the benchmark compares both); -fopenmp renders rows in parallel.  Output
@@ -45,6 +50,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "kdtree.h"
 #ifdef _OPENMP
 #include <omp.h>
 #define OMP(directive) _Pragma(#directive)
@@ -56,6 +62,8 @@
 #define REAL double
 #endif
 typedef REAL real;
+/* The unit roundoff of `real`, for error bounds that follow the build. */
+#define REAL_EPS (sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON)
 
 /* ---------------------------------------------------------------- vectors */
 
@@ -86,10 +94,21 @@ static real maxabs(vec a)
 /* ------------------------------------------------------------------ scene */
 
 /* minray's material: diffuse, mirror, transmitted and emitted weights, and
- * the index of refraction (the ray bends by 1/ir going in, ir coming out). */
-typedef struct { vec color; real kd, ks, kt, kl, ir; } Material;
+ * the index of refraction inside (the ray bends by 1/ir going in, by ir
+ * coming out).  shine > 0 adds a Phong highlight (NFF's materials have one;
+ * minray's spheres do not). */
+typedef struct { vec color; real kd, ks, kt, kl, ir, shine; } Material;
 
-typedef struct { vec cen; real rad; Material m; } Sphere;
+typedef struct { vec cen; real rad; int mat; } Sphere;
+
+/* Vertices and normals are indices into the scene's shared arrays, so two
+ * triangles that share an edge share its exact coordinates. */
+typedef struct {
+    int v[3], n[3];      /* n[0] < 0: no vertex normals, shade flat */
+    int mat;
+    char cull;           /* 1: one-sided, hit from the front only */
+    char degenerate;     /* zero area: never hit */
+} Triangle;
 
 /* A light is either one of minray's emitting spheres (sphere >= 0: lit when
  * the nearest thing toward its centre is that sphere) or a point light
@@ -103,26 +122,36 @@ typedef struct {
 } Camera;
 
 typedef struct {
-    Sphere *sph;
-    int nsph, capsph;
-    Light *light;
-    int nlight, caplight;
+    Material *mat;  int nmat, capmat;
+    Sphere *sph;    int nsph, capsph;
+    Triangle *tri;  int ntri, captri;
+    vec *vert;      int nvert, capvert;
+    vec *norm;      int nnorm, capnorm;
+    Light *light;   int nlight, caplight;
     Camera cam;
     int w, h, depth;
     vec ambient, background;
+    int cull;                 /* for triangles still to come: `sided 1` */
+    kd_tree *tree;            /* NULL: nearest_hit tests every object */
+    kd_prims prims;
 } Scene;
+
+/* Objects are numbered spheres first, then triangles. */
+static int nobj(const Scene *s) { return s->nsph + s->ntri; }
 
 typedef struct { vec o, d; } Ray;
 
 typedef struct {
     real t;
-    int obj;  /* index into the sphere list */
-    vec p, n; /* point and outward unit normal */
+    int obj, mat;
+    vec p;        /* the point */
+    vec n, ng;    /* shading and geometric normal, both outward (front) */
+    real size;    /* coordinate magnitude behind p's rounding error */
 } Hit;
 
 /* What --stats counts; each thread keeps its own and they are summed. */
 typedef struct {
-    unsigned long long primary, shadow, reflected, refracted, hits, tests;
+    unsigned long long primary, shadow, reflected, refracted, hits, tests, steps, queries;
 } Stats;
 
 /* ----------------------------------------------------- sphere intersection */
@@ -155,25 +184,292 @@ static real hit_sphere(const Sphere *s, Ray r, real tmin)
     return INFINITY;
 }
 
+/* --------------------------------------------------- triangle intersection */
+
+/* a*d - b*c to within 2 ulps of its value (Kahan's algorithm with a fused
+ * multiply-add; Jeannerod, Louvet and Muller, Math. Comp. 82, 2013), so its
+ * sign is always the true sign of the rounded inputs, and 0 only when the
+ * determinant is exactly 0. */
+static double det2(double a, double b, double c, double d)
+{
+    double w = b * c;
+    return fma(a, d, -w) + fma(-b, c, w);
+}
+
+/* Does the ray pass through triangle a b c, edges and corners included?
+ * Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection" (JCGT 2(1),
+ * 2013): shear space so that the ray runs along an axis from the origin,
+ * then ask on which side of each edge the origin lies.  Each vertex is moved
+ * by the same arithmetic in every triangle that shares it, and each side is
+ * decided by an exact sign (det2), so the triangles around an edge or a
+ * vertex tile the plane with no gap for a ray to slip through. */
+static int watertight_inside(vec a, vec b, vec c, Ray r)
+{
+    double d[3], o[3], p[3][3], x[3], y[3], u, v, w, sx, sy;
+    int kz, kx, ky, i, k;
+    vec q[3];
+    q[0] = a; q[1] = b; q[2] = c;
+    d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
+    o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
+    kz = fabs(d[0]) > fabs(d[1]) ? (fabs(d[0]) > fabs(d[2]) ? 0 : 2) : (fabs(d[1]) > fabs(d[2]) ? 1 : 2);
+    kx = (kz + 1) % 3;
+    ky = (kx + 1) % 3;
+    sx = d[kx] / d[kz];
+    sy = d[ky] / d[kz];
+    for (i = 0; i < 3; i++) {
+        p[i][0] = q[i].x; p[i][1] = q[i].y; p[i][2] = q[i].z;
+        for (k = 0; k < 3; k++) p[i][k] -= o[k];
+        x[i] = p[i][kx] - sx * p[i][kz];
+        y[i] = p[i][ky] - sy * p[i][kz];
+    }
+    u = det2(x[2], y[2], x[1], y[1]);   /* edge b c */
+    v = det2(x[0], y[0], x[2], y[2]);   /* edge c a */
+    w = det2(x[1], y[1], x[0], y[0]);   /* edge a b */
+    if (!((u >= 0 && v >= 0 && w >= 0) || (u <= 0 && v <= 0 && w <= 0))) return 0;
+    return u + v + w != 0;              /* 0: the ray lies in the triangle's plane */
+}
+
+/* Moller and Trumbore, "Fast, Minimum Storage Ray/Triangle Intersection"
+ * (1997), as the lecture prints it, with three changes:
+ *  - No epsilon.  The original rejects |det| < 1e-6, but det grows with the
+ *    square of the triangle's size, so small triangles vanish (legs of 2e-4
+ *    give det 4e-8).  The bounds are compared as u <= det instead of u/det
+ *    <= 1, which no scale changes; only det == 0 (a ray in the triangle's
+ *    plane, or a triangle of zero area) is rejected.  Every test is written
+ *    so that NaN fails it.
+ *  - t must be in (0, tmax]; the sign is checked before the division.
+ *  - Watertight: rounding can put a ray through a shared edge or vertex
+ *    outside every triangle there.  When a bound fails by less than 1e-7 of
+ *    det (far below any visible distance, far above the rounding error),
+ *    the exact test watertight_inside() decides instead.  That is rare, so
+ *    the common case keeps Moller and Trumbore's speed.
+ * Returns 1 and t, u, v (barycentrics of v1 and v2) on a hit. */
+static int hit_triangle(const Scene *s, const Triangle *tr, Ray r, real tmax,
+                        real *t, real *u, real *v)
+{
+    vec v0 = s->vert[tr->v[0]], v1 = s->vert[tr->v[1]], v2 = s->vert[tr->v[2]];
+    vec e1 = sub(v1, v0), e2 = sub(v2, v0), p = cross(r.d, e2), tv, q;
+    real det = dot(e1, p), uu, vv, tt, slack;
+    if (tr->degenerate) return 0;
+    if (tr->cull) {                      /* the lecture's culling branch */
+        if (!(det > 0)) return 0;
+    } else if (!(det != 0 && det == det)) /* the non-culling branch */
+        return 0;
+    tv = sub(r.o, v0);
+    uu = dot(tv, p);
+    q = cross(tv, e1);
+    vv = dot(r.d, q);
+    tt = dot(e2, q);
+    if (det < 0) { det = -det; uu = -uu; vv = -vv; tt = -tt; }
+    if (!(tt > 0)) return 0;                    /* behind the origin */
+    if (!(uu >= 0 && vv >= 0 && uu + vv <= det)) {
+        slack = (real)1e-7 * det;
+        if (!(uu >= -slack && vv >= -slack && uu + vv <= det + slack)) return 0;
+        if (!watertight_inside(v0, v1, v2, r)) return 0;
+    }
+    *t = tt / det;      /* compared after the division: a tie at tmax must be exact */
+    if (!(*t <= tmax)) return 0;
+    *u = uu / det;
+    *v = vv / det;
+    return 1;
+}
+
+/* Zero area (a repeated vertex, or three in a line) to within rounding: such
+ * a triangle has no inside and no normal, so it is never hit.  Relative to
+ * the edge lengths, so that tiny but proper triangles stay. */
+static int degenerate(vec a, vec b, vec c)
+{
+    vec e1 = sub(b, a), e2 = sub(c, a), n = cross(e1, e2);
+    real k = 64 * REAL_EPS * sqrt(dot(e1, e1) * dot(e2, e2));
+    return !(sqrt(dot(n, n)) > k);
+}
+
 /* ------------------------------------------------------------ nearest hit */
 
-/* The nearest object along r, as the lecture's "find the nearest hit"
- * (t, point, object, normal).  Returns 0 when r hits nothing. */
+/* Object i against the ray: 1 and its t when hit with 0 < t <= tmax. */
+static int hit_object(const Scene *s, int i, Ray r, real tmax, real *t)
+{
+    real u, v;
+    if (i < s->nsph) {
+        *t = hit_sphere(&s->sph[i], r, 0);
+        return *t <= tmax && *t < INFINITY;     /* INFINITY is a miss */
+    }
+    return hit_triangle(s, &s->tri[i - s->nsph], r, tmax, t, &u, &v);
+}
+
+/* The point, normals and material of the hit on object i at t. */
+static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
+{
+    h->t = t;
+    h->obj = i;
+    if (i < s->nsph) {
+        const Sphere *o = &s->sph[i];
+        h->p = comb(t, r.d, r.o);
+        h->n = h->ng = unit(sub(h->p, o->cen));
+        h->mat = o->mat;
+        h->size = maxabs(h->p) + maxabs(o->cen) + o->rad + maxabs(r.o);
+    } else {
+        const Triangle *tr = &s->tri[i - s->nsph];
+        vec a = s->vert[tr->v[0]], b = s->vert[tr->v[1]], c = s->vert[tr->v[2]];
+        real u, v, tt;
+        hit_triangle(s, tr, r, INFINITY, &tt, &u, &v);
+        /* from the barycentrics, not o + t d: exact to the triangle's own
+         * rounding, however far away the ray came from */
+        h->p = add(add(scale(1 - u - v, a), scale(u, b)), scale(v, c));
+        h->ng = unit(cross(sub(b, a), sub(c, a)));
+        h->n = h->ng;
+        if (tr->n[0] >= 0) {
+            vec n = add(add(scale(1 - u - v, s->norm[tr->n[0]]), scale(u, s->norm[tr->n[1]])),
+                        scale(v, s->norm[tr->n[2]]));
+            if (dot(n, n) > 0) h->n = unit(dot(n, h->ng) < 0 ? scale(-1, n) : n);
+        }
+        h->mat = tr->mat;
+        h->size = maxabs(a) + maxabs(b) + maxabs(c);
+    }
+}
+
+/* The kd-tree sees objects only through these three callbacks. */
+static void kd_bounds(void *user, int i, double lo[3], double hi[3])
+{
+    const Scene *s = user;
+    int k;
+    if (i < s->nsph) {
+        const Sphere *o = &s->sph[i];
+        lo[0] = o->cen.x - o->rad; lo[1] = o->cen.y - o->rad; lo[2] = o->cen.z - o->rad;
+        hi[0] = o->cen.x + o->rad; hi[1] = o->cen.y + o->rad; hi[2] = o->cen.z + o->rad;
+        return;
+    }
+    for (k = 0; k < 3; k++) {
+        vec p = s->vert[s->tri[i - s->nsph].v[k]];
+        double c[3];
+        int a;
+        c[0] = p.x; c[1] = p.y; c[2] = p.z;
+        for (a = 0; a < 3; a++) {
+            if (k == 0 || c[a] < lo[a]) lo[a] = c[a];
+            if (k == 0 || c[a] > hi[a]) hi[a] = c[a];
+        }
+    }
+}
+
+/* The box of the part of a triangle inside [blo, bhi]: the triangle clipped
+ * by the box's six planes (Sutherland and Hodgman, 1974), so that the tree
+ * can split a long triangle exactly ("perfect splits", Havran 2000).  A
+ * sphere is simply boxed and cut to the box. */
+static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
+                   double lo[3], double hi[3])
+{
+    const Scene *s = user;
+    double poly[2][9][3];
+    int n = 3, k, a, side, cur = 0;
+    kd_bounds(user, i, lo, hi);
+    if (i < s->nsph) {
+        for (a = 0; a < 3; a++) {
+            if (lo[a] < blo[a]) lo[a] = blo[a];
+            if (hi[a] > bhi[a]) hi[a] = bhi[a];
+            if (lo[a] > hi[a]) return 0;
+        }
+        return 1;
+    }
+    for (k = 0; k < 3; k++) {
+        vec p = s->vert[s->tri[i - s->nsph].v[k]];
+        poly[0][k][0] = p.x; poly[0][k][1] = p.y; poly[0][k][2] = p.z;
+    }
+    for (a = 0; a < 3; a++)
+        for (side = 0; side < 2; side++) {
+            double plane = side ? bhi[a] : blo[a], sign = side ? -1 : 1;
+            int m = 0;
+            const double (*in)[3] = (const double (*)[3])poly[cur];
+            double (*out)[3] = poly[1 - cur];
+            for (k = 0; k < n; k++) {
+                const double *p = in[k], *q = in[(k + 1) % n];
+                double dp = sign * (p[0 + a] - plane), dq = sign * (q[a] - plane);
+                if (dp >= 0) { memcpy(out[m++], p, sizeof out[0]); }
+                if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) {
+                    double f = dp / (dp - dq);
+                    int c;
+                    for (c = 0; c < 3; c++) out[m][c] = p[c] + f * (q[c] - p[c]);
+                    out[m][a] = plane;     /* exactly on the plane, not near it */
+                    m++;
+                }
+            }
+            n = m;
+            cur = 1 - cur;
+            if (n == 0) return 0;
+        }
+    for (a = 0; a < 3; a++) {
+        lo[a] = hi[a] = poly[cur][0][a];
+        for (k = 1; k < n; k++) {
+            if (poly[cur][k][a] < lo[a]) lo[a] = poly[cur][k][a];
+            if (poly[cur][k][a] > hi[a]) hi[a] = poly[cur][k][a];
+        }
+    }
+    return 1;
+}
+
+static int kd_hit(void *user, int i, const void *ray, double tmin, double tmax, double *t)
+{
+    real tt;
+    (void)tmin;             /* rays start off the surface; see spawn() */
+    if (!hit_object(user, i, *(const Ray *)ray, (real)tmax, &tt)) return 0;
+    *t = tt;
+    return 1;
+}
+
+/* More objects than this and the tree pays: below it a loop over all of them
+ * costs less than walking even a small tree (measured on the minray scene,
+ * where the loop is about twice as fast). */
+#define TREE_FROM 16
+
+/* The lecture's "find the nearest hit" (t, point, object, normal).
+ * Returns 0 when r hits nothing. */
 static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
 {
-    int i;
-    h->t = INFINITY;
-    h->obj = -1;
-    for (i = 0; i < s->nsph; i++) {
-        real t = hit_sphere(&s->sph[i], r, 0);
-        if (t < h->t) { h->t = t; h->obj = i; }
+    real t = INFINITY, ti;
+    int i, best = -1;
+    st->queries++;
+    if (s->tree) {
+        double o[3], d[3], tmax = INFINITY;
+        kd_counters c = { 0, 0, 0 };
+        o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
+        d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
+        best = kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, &c);
+        t = (real)tmax;
+        st->steps += c.steps;
+        st->tests += c.tests;
+    } else {
+        for (i = 0; i < nobj(s); i++)
+            if (hit_object(s, i, r, t, &ti) && ti < t) { t = ti; best = i; }
+        st->tests += (unsigned long long)nobj(s);
     }
-    st->tests += (unsigned long long)s->nsph;
-    if (h->obj < 0) return 0;
+    if (best < 0) return 0;
     st->hits++;
-    h->p = comb(h->t, r.d, r.o);
-    h->n = unit(sub(h->p, s->sph[h->obj].cen));
+    surface(s, r, best, t, h);
     return 1;
+}
+
+/* Is anything hit with 0 < t <= tmax?  For shadow rays to point lights,
+ * where any blocker will do and the nearest is not needed. */
+static int any_hit(const Scene *s, Ray r, real tmax, Stats *st)
+{
+    real t;
+    int i;
+    st->queries++;
+    if (s->tree) {
+        double o[3], d[3];
+        kd_counters c = { 0, 0, 0 };
+        int hit;
+        o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
+        d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
+        hit = kd_any(s->tree, &s->prims, o, d, &r, 0, tmax, &c);
+        st->steps += c.steps;
+        st->tests += c.tests;
+        return hit;
+    }
+    for (i = 0; i < nobj(s); i++) {
+        st->tests++;
+        if (hit_object(s, i, r, tmax, &t)) return 1;
+    }
+    return 0;
 }
 
 /* A secondary ray starts on the surface it leaves.  With a fixed epsilon in
@@ -184,33 +480,31 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
  * whatever the scene's units (Pharr, Jakob and Humphreys, pbrt 3rd ed.,
  * sect. 3.9.5, "Robust spawned ray origins").  The 64 covers the dozen or so
  * roundings between the ray, the root and the point, with margin. */
-static Ray spawn(const Scene *s, const Hit *h, vec dir)
+static Ray spawn(const Hit *h, vec dir)
 {
-    const Sphere *o = &s->sph[h->obj];
-    real size = maxabs(h->p) + maxabs(o->cen) + o->rad;
-    real eps = 64 * (sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON) * size;
+    real eps = 64 * REAL_EPS * h->size;
     Ray r;
-    r.o = comb(dot(dir, h->n) >= 0 ? eps : -eps, h->n, h->p);
+    r.o = comb(dot(dir, h->ng) >= 0 ? eps : -eps, h->ng, h->p);
     r.d = dir;
     return r;
 }
 
 /* The lecture's shadow ray: is light l seen from the hit point?  *e returns
- * its strength kl * cos(angle to the normal) and the direction is unit. */
+ * its strength kl * cos(angle to the normal n). */
 static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
                       real *e, Stats *st)
 {
     vec dir = unit(sub(l->pos, h->p));
     Ray r;
     Hit blocker;
-    real k = l->sphere >= 0 ? s->sph[l->sphere].m.kl : 1;
+    real k = l->sphere >= 0 ? s->mat[s->sph[l->sphere].mat].kl : 1;
     *e = k * dot(n, dir);
     if (!(*e > 0)) return 0;    /* facing away: no ray, as the SPD rules say */
     st->shadow++;
-    r = spawn(s, h, dir);
-    if (!nearest_hit(s, r, &blocker, st)) return l->sphere < 0;
-    if (l->sphere >= 0) return blocker.obj == l->sphere;
-    return blocker.t >= sqrt(dot(sub(l->pos, r.o), sub(l->pos, r.o))); /* beyond the light */
+    r = spawn(h, dir);
+    if (l->sphere < 0)          /* a point light: anything before it blocks */
+        return !any_hit(s, r, sqrt(dot(sub(l->pos, r.o), sub(l->pos, r.o))), st);
+    return nearest_hit(s, r, &blocker, st) && blocker.obj == l->sphere;
 }
 
 /* ------------------------------------------------------------ RayTrace(R) */
@@ -231,29 +525,36 @@ static int refract(vec d, vec n, real cosi, real eta, vec *t)
 
 static vec trace(const Scene *s, Ray r, int depth, Stats *st);
 
-/* Local light, then reflection and refraction by recursion: minray's model.
- * The sums run in the card's order so that the rounding is the card's too. */
+/* Local light, then reflection and refraction by recursion: minray's model,
+ * plus a Phong highlight for materials that have one.  The sums run in the
+ * card's order so that the rounding is the card's too. */
 static vec shade(const Scene *s, Ray r, const Hit *h, int depth, Stats *st)
 {
-    const Material *m = &s->sph[h->obj].m;
-    vec n = h->n, color = s->ambient, c, t;
+    const Material *m = &s->mat[h->mat];
+    vec n = h->n, color = s->ambient, spec = v3(0, 0, 0), c, t;
     real cosi = -dot(r.d, n), eta = 1 / m->ir, e;
     int i;
-    if (cosi < 0) { n = scale(-1, n); cosi = -cosi; eta = m->ir; } /* inside */
+    if (dot(r.d, h->ng) > 0) { n = scale(-1, n); cosi = -cosi; eta = m->ir; } /* inside */
     for (i = 0; i < s->nlight; i++)
-        if (shadow_ray(s, h, n, &s->light[i], &e, st))
+        if (shadow_ray(s, h, n, &s->light[i], &e, st)) {
             color = comb(e, s->light[i].color, color);
+            if (m->shine > 0) {     /* Phong (1975): the mirror direction against the light's */
+                real rl = dot(reflect(r.d, n, cosi), unit(sub(s->light[i].pos, h->p)));
+                if (rl > 0) spec = comb(pow(rl, m->shine), s->light[i].color, spec);
+            }
+        }
     color = mul(color, m->color);
 
     c = scale(m->kl, m->color);                 /* emission */
     c = comb(m->kd, color, c);                  /* diffuse */
-    if (m->ks > 0) {
+    if (m->shine > 0) c = comb(m->ks, spec, c); /* highlight */
+    if (m->ks > 0 && depth > 1) {               /* at depth 1 it would return black */
         st->reflected++;
-        c = comb(m->ks, trace(s, spawn(s, h, reflect(r.d, n, cosi)), depth - 1, st), c);
+        c = comb(m->ks, trace(s, spawn(h, reflect(r.d, n, cosi)), depth - 1, st), c);
     }
-    if (m->kt > 0 && refract(r.d, n, cosi, eta, &t)) {
+    if (m->kt > 0 && depth > 1 && refract(r.d, n, cosi, eta, &t)) {
         st->refracted++;
-        c = comb(m->kt, trace(s, spawn(s, h, t), depth - 1, st), c);
+        c = comb(m->kt, trace(s, spawn(h, t), depth - 1, st), c);
     }
     return c;
 }
@@ -338,6 +639,8 @@ static void add_stats(Stats *to, const Stats *from)
     to->refracted += from->refracted;
     to->hits += from->hits;
     to->tests += from->tests;
+    to->steps += from->steps;
+    to->queries += from->queries;
 }
 
 /* Rows go to threads one at a time, as they free up; each pixel is written
@@ -376,8 +679,6 @@ static void render(const Scene *s, const Options *o, unsigned char *img, Stats *
 
 /* ------------------------------------------------------------ scene input */
 
-#define MAXTOK 16
-
 typedef struct { const char *file; int line; } Where;
 
 static int fail(Where w, const char *msg, const char *arg)
@@ -386,8 +687,19 @@ static int fail(Where w, const char *msg, const char *arg)
     return 0;
 }
 
-/* Reads the n numbers after tok[first]; finite numbers only.  `what` names
- * the line's kind for the message. */
+/* One finite number from a token, or a message saying what is wrong. */
+static int number(Where w, const char *tok, real *out)
+{
+    char *end;
+    double v = strtod(tok, &end);
+    if (end == tok || *end) return fail(w, "not a number", tok);
+    if (!isfinite(v)) return fail(w, "number must be finite", tok);
+    *out = (real)v;
+    return 1;
+}
+
+/* The n numbers after tok[first], and nothing else on the line.  `what`
+ * names the line's kind for the message. */
 static int numbers(Where w, const char *what, char **tok, int ntok, int first, int n, real *out)
 {
     int i;
@@ -396,50 +708,196 @@ static int numbers(Where w, const char *what, char **tok, int ntok, int first, i
         sprintf(buf, "%.40s needs %d numbers, found %d", what, n, ntok - first);
         return fail(w, buf, NULL);
     }
-    for (i = 0; i < n; i++) {
-        char *end;
-        double v = strtod(tok[first + i], &end);
-        if (end == tok[first + i] || *end) return fail(w, "not a number", tok[first + i]);
-        if (!isfinite(v)) return fail(w, "number must be finite", tok[first + i]);
-        out[i] = (real)v;
-    }
+    for (i = 0; i < n; i++)
+        if (!number(w, tok[first + i], &out[i])) return 0;
     return 1;
 }
 
+/* Room for one more element in a growing array. */
 static void *grow(void *p, int *cap, int need, size_t size)
 {
     if (need <= *cap) return p;
     *cap = *cap ? 2 * *cap : 16;
+    if (*cap < need) *cap = need;
     p = realloc(p, (size_t)*cap * size);
     if (!p) { fprintf(stderr, "ray: out of memory\n"); exit(1); }
     return p;
 }
 
-static int add_light(Scene *s, vec pos, vec color, int sphere)
+static void add_light(Scene *s, vec pos, vec color, int sphere)
 {
     s->light = grow(s->light, &s->caplight, s->nlight + 1, sizeof *s->light);
     s->light[s->nlight].pos = pos;
     s->light[s->nlight].color = color;
     s->light[s->nlight].sphere = sphere;
     s->nlight++;
+}
+
+static int add_material(Scene *s, Material m)
+{
+    s->mat = grow(s->mat, &s->capmat, s->nmat + 1, sizeof *s->mat);
+    s->mat[s->nmat] = m;
+    return s->nmat++;
+}
+
+static void add_sphere(Scene *s, vec cen, real rad, int mat)
+{
+    Sphere *p;
+    s->sph = grow(s->sph, &s->capsph, s->nsph + 1, sizeof *s->sph);
+    p = &s->sph[s->nsph++];
+    p->cen = cen;
+    p->rad = rad;
+    p->mat = mat;
+    if (s->mat[mat].kl > 0) add_light(s, cen, s->mat[mat].color, s->nsph - 1);
+}
+
+static int add_vertex(Scene *s, vec p)
+{
+    s->vert = grow(s->vert, &s->capvert, s->nvert + 1, sizeof *s->vert);
+    s->vert[s->nvert] = p;
+    return s->nvert++;
+}
+
+static int add_normal(Scene *s, vec n)
+{
+    s->norm = grow(s->norm, &s->capnorm, s->nnorm + 1, sizeof *s->norm);
+    s->norm[s->nnorm] = n;
+    return s->nnorm++;
+}
+
+/* Vertices a, b, c and normals na, nb, nc (-1: none) by index. */
+static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, int mat)
+{
+    Triangle *t;
+    s->tri = grow(s->tri, &s->captri, s->ntri + 1, sizeof *s->tri);
+    t = &s->tri[s->ntri++];
+    t->v[0] = a; t->v[1] = b; t->v[2] = c;
+    if (na < 0 || nb < 0 || nc < 0) na = nb = nc = -1;
+    t->n[0] = na; t->n[1] = nb; t->n[2] = nc;
+    t->mat = mat;
+    t->cull = (char)s->cull;
+    t->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
+}
+
+/* Twice the signed area of the 2-D triangle a b c. */
+static double area2(const double *a, const double *b, const double *c)
+{
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* Is 2-D point p inside or on the triangle a b c (counter-clockwise)? */
+static int inside2(const double *p, const double *a, const double *b, const double *c)
+{
+    return area2(a, b, p) >= 0 && area2(b, c, p) >= 0 && area2(c, a, p) >= 0;
+}
+
+/* A planar polygon, convex or not, as triangles, by ear clipping (Meisters,
+ * "Polygons have ears", 1975): a corner whose triangle is convex and holds
+ * no other corner can be cut off, and some corner always can.  A fan from
+ * one vertex would be wrong for the gears' concave 144-gons.  The polygon
+ * is projected on the plane of its normal's largest axis (Newell's normal,
+ * robust for any simple polygon).  vi and ni are vertex and normal indices
+ * (ni may be NULL). */
+static void triangulate(Scene *s, const int *vi, const int *ni, int n, int mat)
+{
+    double (*p)[2] = malloc((size_t)n * sizeof *p), nn[3] = { 0, 0, 0 };
+    int *idx = malloc((size_t)n * sizeof *idx), m = n, k, j, ax, ux, vx;
+    if (!p || !idx) { fprintf(stderr, "ray: out of memory\n"); exit(1); }
+    for (k = 0; k < n; k++) {
+        vec a = s->vert[vi[k]], b = s->vert[vi[(k + 1) % n]];
+        nn[0] += (a.y - b.y) * (a.z + b.z);
+        nn[1] += (a.z - b.z) * (a.x + b.x);
+        nn[2] += (a.x - b.x) * (a.y + b.y);
+    }
+    ax = fabs(nn[0]) > fabs(nn[1]) ? (fabs(nn[0]) > fabs(nn[2]) ? 0 : 2) : (fabs(nn[1]) > fabs(nn[2]) ? 1 : 2);
+    ux = (ax + 1) % 3;                 /* (ux, vx, ax) is a right-handed cycle: */
+    vx = (ax + 2) % 3;                 /* counter-clockwise seen from +ax */
+    if (nn[ax] < 0) { j = ux; ux = vx; vx = j; }
+    for (k = 0; k < n; k++) {
+        vec a = s->vert[vi[k]];
+        double c[3];
+        c[0] = a.x; c[1] = a.y; c[2] = a.z;
+        p[k][0] = c[ux];
+        p[k][1] = c[vx];
+        idx[k] = k;
+    }
+    for (k = 0; m > 3; ) {
+        int tries, i0 = 0, i1 = 0, i2 = 0, ear = 0;
+        for (tries = 0; tries < m && !ear; tries++, k = (k + 1) % m) {
+            i0 = idx[(k + m - 1) % m]; i1 = idx[k]; i2 = idx[(k + 1) % m];
+            if (area2(p[i0], p[i1], p[i2]) <= 0) continue;      /* reflex or flat */
+            ear = 1;
+            for (j = 0; j < m && ear; j++) {
+                int q = idx[j];
+                if (q != i0 && q != i1 && q != i2 && inside2(p[q], p[i0], p[i1], p[i2])
+                    && memcmp(p[q], p[i0], sizeof p[q]) && memcmp(p[q], p[i1], sizeof p[q])
+                    && memcmp(p[q], p[i2], sizeof p[q]))
+                    ear = 0;
+            }
+            if (ear) break;
+        }
+        if (!ear) {   /* only flat or self-touching corners left: cut one anyway */
+            i0 = idx[(k + m - 1) % m]; i1 = idx[k]; i2 = idx[(k + 1) % m];
+        }
+        add_triangle(s, vi[i0], vi[i1], vi[i2], ni ? ni[i0] : -1, ni ? ni[i1] : -1, ni ? ni[i2] : -1, mat);
+        memmove(idx + k, idx + k + 1, (size_t)(m - k - 1) * sizeof *idx);
+        m--;
+        if (k >= m) k = 0;
+    }
+    add_triangle(s, vi[idx[0]], vi[idx[1]], vi[idx[2]], ni ? ni[idx[0]] : -1,
+                 ni ? ni[idx[1]] : -1, ni ? ni[idx[2]] : -1, mat);
+    free(p);
+    free(idx);
+}
+
+/* NFF's cones and cylinders (`c`, open at both ends) as triangles with
+ * smooth normals.  32 segments keep the silhouette within 0.5% of the radius
+ * (1 - cos(pi/32)), under a pixel for the SPD scenes at 512x512, and let the
+ * kd-tree handle them like any mesh. */
+#define CONE_SEGMENTS 32
+static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
+{
+    vec axis = sub(apex, base), ax = unit(axis), u, v;
+    real len = sqrt(dot(axis, axis));
+    int k, first = s->nvert, nfirst = s->nnorm;
+    u = unit(cross(ax, fabs(ax.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
+    v = cross(ax, u);
+    for (k = 0; k < CONE_SEGMENTS; k++) {
+        real a = 2 * 3.14159265358979323846 * k / CONE_SEGMENTS;
+        vec radial = add(scale(cos(a), u), scale(sin(a), v));
+        add_vertex(s, comb(rb, radial, base));
+        add_vertex(s, comb(ra, radial, apex));
+        add_normal(s, unit(comb((rb - ra) / len, ax, radial)));
+    }
+    for (k = 0; k < CONE_SEGMENTS; k++) {
+        int k1 = (k + 1) % CONE_SEGMENTS;
+        int b0 = first + 2 * k, a0 = b0 + 1, b1 = first + 2 * k1, a1 = b1 + 1;
+        if (rb > 0) add_triangle(s, b0, b1, a1, nfirst + k, nfirst + k1, nfirst + k1, mat);
+        if (ra > 0) add_triangle(s, b0, a1, a0, nfirst + k, nfirst + k1, nfirst + k, mat);
+    }
+}
+
+/* r g b kd ks kt kl ir: minray's material fields, for tri and mesh lines. */
+static int material8(Scene *s, Where w, const real *v, int *mat)
+{
+    Material m;
+    if (!(v[7] > 0)) return fail(w, "index of refraction must be positive", NULL);
+    m.color = v3(v[0], v[1], v[2]);
+    m.kd = v[3]; m.ks = v[4]; m.kt = v[5]; m.kl = v[6]; m.ir = v[7]; m.shine = 0;
+    *mat = add_material(s, m);
     return 1;
 }
 
 /* One sphere: minray's 12 numbers in minray's order. */
 static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
 {
-    real v[12];
-    Sphere *p;
+    real v[12], m[8];
+    int mat, k;
     if (!numbers(w, "a sphere", tok, ntok, 0, 12, v)) return 0;
     if (!(v[6] > 0)) return fail(w, "sphere radius must be positive", tok[6]);
-    if (!(v[11] > 0)) return fail(w, "index of refraction must be positive", tok[11]);
-    s->sph = grow(s->sph, &s->capsph, s->nsph + 1, sizeof *s->sph);
-    p = &s->sph[s->nsph++];
-    p->cen = v3(v[0], v[1], v[2]);
-    p->m.color = v3(v[3], v[4], v[5]);
-    p->rad = v[6];
-    p->m.kd = v[7]; p->m.ks = v[8]; p->m.kt = v[9]; p->m.kl = v[10]; p->m.ir = v[11];
-    if (p->m.kl > 0) add_light(s, p->cen, p->m.color, s->nsph - 1);
+    for (k = 0; k < 8; k++) m[k] = v[k < 3 ? 3 + k : 4 + k];   /* all but the radius */
+    if (!material8(s, w, m, &mat)) return 0;
+    add_sphere(s, v3(v[0], v[1], v[2]), v[6], mat);
     return 1;
 }
 
@@ -473,11 +931,113 @@ static int check_size(double fw, double fh, int *width, int *height)
     return 1;
 }
 
+/* Splits a line into at most max blank-separated tokens; '#' starts a
+ * comment.  Returns max + 1 when there are more. */
+static int tokens(char *line, char **tok, int max)
+{
+    int n = 0;
+    char *p = strchr(line, '#');
+    if (p) *p = 0;
+    for (p = strtok(line, " \t\r\n"); p && n < max; p = strtok(NULL, " \t\r\n"))
+        tok[n++] = p;
+    return p ? max + 1 : n;
+}
+
+/* Reads the next line of f into line; 0 at the end or on an over-long line
+ * (then *ok is cleared and the message printed). */
+static int next_line(FILE *f, char *line, int size, Where *w, int *ok)
+{
+    if (!fgets(line, size, f)) return 0;
+    w->line++;
+    if (!strchr(line, '\n') && !feof(f)) return *ok = fail(*w, "line too long", NULL);
+    return 1;
+}
+
+/* An OBJ face corner "v", "v/t", "v//n" or "v/t/n"; indices count from 1,
+ * or back from the newest when negative.  *n is -1 without a normal. */
+static int obj_corner(Where w, char *c, int nv, int nn, int *v, int *n)
+{
+    char *end, *slash;
+    long i = strtol(c, &end, 10);
+    if (end == c || (*end && *end != '/')) return fail(w, "bad face corner", c);
+    if (i < 0) i += nv + 1;
+    if (i < 1 || i > nv) return fail(w, "vertex index out of range", c);
+    *v = (int)i - 1;
+    *n = -1;
+    slash = strchr(c, '/');
+    if (slash && (slash = strchr(slash + 1, '/')) && slash[1]) {
+        i = strtol(slash + 1, &end, 10);
+        if (end == slash + 1 || *end) return fail(w, "bad face corner", c);
+        if (i < 0) i += nn + 1;
+        if (i < 1 || i > nn) return fail(w, "normal index out of range", c);
+        *n = (int)i - 1;
+    }
+    return 1;
+}
+
+/* Wavefront OBJ: v, vn and f (any number of corners); every other statement
+ * is skipped with one warning for the file.  `from` is the scene line that
+ * asked for it, for the message when it cannot be opened. */
+#define OBJ_MAXCORNERS 1024
+static int load_obj(Scene *s, const char *file, int mat, Where from)
+{
+    static char *tok[OBJ_MAXCORNERS + 2];
+    char line[16384], first_skipped[32] = "";
+    int vi[OBJ_MAXCORNERS], ni[OBJ_MAXCORNERS], v0 = s->nvert, n0 = s->nnorm, ok = 1, skipped = 0, skipped_line = 0;
+    Where w;
+    FILE *f = fopen(file, "r");
+    if (!f) return fail(from, "cannot open mesh", strerror(errno));
+    w.file = file;
+    w.line = 0;
+    while (ok && next_line(f, line, sizeof line, &w, &ok)) {
+        int n = tokens(line, tok, OBJ_MAXCORNERS + 1), k, with_normals = 1;
+        real x[3];
+        if (n == 0) continue;
+        if (n > OBJ_MAXCORNERS) { ok = fail(w, "face with more than 1023 corners", NULL); break; }
+        if (!strcmp(tok[0], "v") && n == 5) n = 4;     /* an optional w, unused */
+        if (!strcmp(tok[0], "v")) ok = numbers(w, "v", tok, n, 1, 3, x) && add_vertex(s, v3(x[0], x[1], x[2])) >= 0;
+        else if (!strcmp(tok[0], "vn")) ok = numbers(w, "vn", tok, n, 1, 3, x) && add_normal(s, v3(x[0], x[1], x[2])) >= 0;
+        else if (!strcmp(tok[0], "f")) {
+            if (n < 4) { ok = fail(w, "a face needs 3 corners or more", NULL); break; }
+            for (k = 1; k < n && ok; k++) {
+                ok = obj_corner(w, tok[k], s->nvert - v0, s->nnorm - n0, &vi[k - 1], &ni[k - 1]);
+                vi[k - 1] += v0;
+                if (ni[k - 1] < 0) with_normals = 0;
+                else ni[k - 1] += n0;
+            }
+            if (ok) triangulate(s, vi, with_normals ? ni : NULL, n - 1, mat);
+        } else if (!skipped++) {
+            skipped_line = w.line;
+            sprintf(first_skipped, "%.20s", tok[0]);
+        }
+    }
+    fclose(f);
+    if (ok && skipped) {
+        w.line = skipped_line;
+        fprintf(stderr, "%s:%d: warning: skipped %d statement%s that are not v, vn or f (the first: %s)\n",
+                file, skipped_line, skipped, skipped == 1 ? "" : "s", first_skipped);
+    }
+    return ok;
+}
+
+/* A path named in a scene is relative to the scene's directory. */
+static char *beside(const char *scene, const char *name)
+{
+    const char *slash = strrchr(scene, '/');
+    size_t dir = name[0] == '/' || !slash ? 0 : (size_t)(slash - scene + 1);
+    char *p = malloc(dir + strlen(name) + 1);
+    if (!p) exit(1);
+    memcpy(p, scene, dir);
+    strcpy(p + dir, name);
+    return p;
+}
+
 /* A keyword line: ray.c's extensions to minray's format. */
 static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
 {
-    real v[10];
+    real v[17];
     const char *k = tok[0];
+    int mat, ok;
     if (!strcmp(k, "size"))
         return numbers(w, k, tok, ntok, 1, 2, v)
                && (check_size(v[0], v[1], &s->w, &s->h) || fail(w, SIZE_RULE, NULL));
@@ -494,26 +1054,41 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
     }
     if (!strcmp(k, "camera"))
         return numbers(w, k, tok, ntok, 1, 10, v) && set_camera(s, w, v);
-    if (!strcmp(k, "light"))
-        return numbers(w, k, tok, ntok, 1, 6, v) && add_light(s, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]), -1);
+    if (!strcmp(k, "light")) {
+        if (!numbers(w, k, tok, ntok, 1, 6, v)) return 0;
+        add_light(s, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]), -1);
+        return 1;
+    }
     if (!strcmp(k, "pixel")) {
         if (ntok != 2 || (strcmp(tok[1], "corner") && strcmp(tok[1], "centre") && strcmp(tok[1], "center")))
             return fail(w, "expected `pixel corner` or `pixel centre`", NULL);
         s->cam.anchor = tok[1][0] == 'c' && tok[1][1] == 'o' ? 0 : (real)0.5;
         return 1;
     }
+    if (!strcmp(k, "sided")) {
+        if (ntok != 2 || (strcmp(tok[1], "1") && strcmp(tok[1], "2")))
+            return fail(w, "expected `sided 1` (front faces only) or `sided 2`", NULL);
+        s->cull = tok[1][0] == '1';
+        return 1;
+    }
+    if (!strcmp(k, "tri")) {
+        int a, b;
+        if (!numbers(w, k, tok, ntok, 1, 17, v) || !material8(s, w, v + 9, &mat)) return 0;
+        a = add_vertex(s, v3(v[0], v[1], v[2]));
+        b = add_vertex(s, v3(v[3], v[4], v[5]));
+        add_triangle(s, a, b, add_vertex(s, v3(v[6], v[7], v[8])), -1, -1, -1, mat);
+        return 1;
+    }
+    if (!strcmp(k, "mesh")) {
+        char *path;
+        if (ntok < 2) return fail(w, "mesh needs a file name and 8 numbers", NULL);
+        if (!numbers(w, k, tok, ntok, 2, 8, v) || !material8(s, w, v, &mat)) return 0;
+        path = beside(w.file, tok[1]);
+        ok = load_obj(s, path, mat, w);
+        free(path);
+        return ok;
+    }
     return fail(w, "unknown keyword", k);
-}
-
-/* Splits a line into blank-separated tokens; '#' starts a comment. */
-static int tokens(char *line, char **tok)
-{
-    int n = 0;
-    char *p = strchr(line, '#');
-    if (p) *p = 0;
-    for (p = strtok(line, " \t\r\n"); p && n < MAXTOK; p = strtok(NULL, " \t\r\n"))
-        tok[n++] = p;
-    return p ? MAXTOK + 1 : n;
 }
 
 static void default_scene(Scene *s)
@@ -527,24 +1102,205 @@ static void default_scene(Scene *s)
     set_camera(s, nowhere, v);
 }
 
-static int load_scene(Scene *s, const char *file)
+/* The sphere format: a line of numbers is a sphere, a line that starts with
+ * a word is a keyword. */
+static int load_sph(Scene *s, FILE *f, Where w)
 {
-    char line[4096], *tok[MAXTOK];
-    Where w = { file, 0 };
-    FILE *f = fopen(file, "r");
+    char line[4096], *tok[24];
     int ok = 1;
-    default_scene(s);
-    if (!f) return fail(w, "cannot open scene", strerror(errno));
-    while (ok && fgets(line, sizeof line, f)) {
-        int n;
-        w.line++;
-        if (!strchr(line, '\n') && !feof(f)) { ok = fail(w, "line longer than 4095 characters", NULL); break; }
-        n = tokens(line, tok);
-        if (n > MAXTOK) ok = fail(w, "too many fields", NULL);
+    while (ok && next_line(f, line, sizeof line, &w, &ok)) {
+        int n = tokens(line, tok, 23);
+        if (n > 23) ok = fail(w, "too many fields", NULL);
         else if (n == 0) continue;
         else if (strchr("+-.0123456789", tok[0][0])) ok = parse_sphere(s, w, tok, n);
         else ok = parse_keyword(s, w, tok, n);
     }
+    return ok;
+}
+
+/* -------- NFF, Eric Haines' Neutral File Format (the SPD scenes' format) */
+
+/* NFF is a stream of blank-separated tokens, not of lines (a cone's eight
+ * numbers may sit on one line or three), so it is read a token at a time. */
+typedef struct { FILE *f; Where w; int c; char tok[64]; } Lexer;
+
+/* The next token into lx->tok; 0 at the end of the file. */
+static int next_token(Lexer *lx)
+{
+    int n = 0;
+    for (;;) {
+        while (lx->c == ' ' || lx->c == '\t' || lx->c == '\r' || lx->c == '\n') {
+            if (lx->c == '\n') lx->w.line++;
+            lx->c = getc(lx->f);
+        }
+        if (lx->c != '#') break;
+        while (lx->c != '\n' && lx->c != EOF) lx->c = getc(lx->f);
+    }
+    while (lx->c != EOF && lx->c != ' ' && lx->c != '\t' && lx->c != '\r' && lx->c != '\n') {
+        if (n < (int)sizeof lx->tok - 1) lx->tok[n++] = (char)lx->c;
+        lx->c = getc(lx->f);
+    }
+    lx->tok[n] = 0;
+    return n > 0;
+}
+
+/* n numbers in a row, after `what`. */
+static int nff_numbers(Lexer *lx, const char *what, int n, real *out)
+{
+    int i;
+    for (i = 0; i < n; i++) {
+        if (!next_token(lx)) return fail(lx->w, "the file ends inside", what);
+        if (!number(lx->w, lx->tok, &out[i])) return 0;
+    }
+    return 1;
+}
+
+/* The view block: from, at, up, angle, hither, resolution.  NFF's angle
+ * spans the centres of the outer pixels, (W-1) pixels, where ours spans the
+ * edges, W pixels. */
+static int nff_view(Scene *s, Lexer *lx)
+{
+    real v[10], x[3], angle = 45, res[2] = { 512, 512 };
+    int seen = 0;
+    const char *names[] = { "from", "at", "up", "angle", "hither", "resolution" };
+    int counts[] = { 3, 3, 3, 1, 1, 2 }, k;
+    while (seen < 6 && next_token(lx)) {
+        for (k = 0; k < 6 && strcmp(lx->tok, names[k]); k++) continue;
+        if (k == 6) return fail(lx->w, "expected from, at, up, angle, hither or resolution", lx->tok);
+        if (!nff_numbers(lx, names[k], counts[k], x)) return 0;
+        if (k < 3) { v[3 * k] = x[0]; v[3 * k + 1] = x[1]; v[3 * k + 2] = x[2]; }
+        if (k == 3) angle = x[0];
+        if (k == 5 && !check_size(x[0], x[1], &s->w, &s->h)) return fail(lx->w, SIZE_RULE, NULL);
+        if (k == 5) { res[0] = x[0]; res[1] = x[1]; }
+        seen++;
+    }
+    if (seen < 6) return fail(lx->w, "the view block needs from, at, up, angle, hither and resolution", NULL);
+    if (!(angle > 0 && angle < 180)) return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
+    v[9] = atan(tan(angle * 3.14159265358979323846 / 360) * res[0] / (res[0] > 1 ? res[0] - 1 : 1))
+           * 360 / 3.14159265358979323846;          /* twice the half angle, in degrees */
+    return set_camera(s, lx->w, v);
+}
+
+/* A polygon of n corners, with a normal at each (pp) or not (p). */
+static int nff_polygon(Scene *s, Lexer *lx, int normals, int mat)
+{
+    real x[6], cnt;
+    int n, k, *vi, *ni, ok = 1;
+    if (!nff_numbers(lx, normals ? "pp" : "p", 1, &cnt)) return 0;
+    if (!(cnt >= 3 && cnt <= 1e6 && cnt == floor(cnt))) return fail(lx->w, "a polygon needs 3 or more corners", lx->tok);
+    n = (int)cnt;
+    vi = malloc((size_t)n * sizeof *vi);
+    ni = malloc((size_t)n * sizeof *ni);
+    if (!vi || !ni) exit(1);
+    for (k = 0; k < n && ok; k++) {
+        ok = nff_numbers(lx, "a polygon", normals ? 6 : 3, x);
+        if (!ok) break;
+        vi[k] = add_vertex(s, v3(x[0], x[1], x[2]));
+        if (normals) ni[k] = add_normal(s, v3(x[3], x[4], x[5]));
+    }
+    if (ok) triangulate(s, vi, normals ? ni : NULL, n, mat);
+    free(vi);
+    free(ni);
+    return ok;
+}
+
+/* l x y z [r g b]: a point light, white unless a colour follows. */
+static int nff_light(Scene *s, Lexer *lx)
+{
+    real x[3], rgb[3] = { 1, 1, 1 };
+    Lexer before;
+    long at;
+    if (!nff_numbers(lx, "l", 3, x)) return 0;
+    before = *lx;                /* look at the next token, and put it back */
+    at = ftell(lx->f);           /* unless it is a number */
+    if (next_token(lx) && strchr("+-.0123456789", lx->tok[0])) {
+        if (!number(lx->w, lx->tok, &rgb[0]) || !nff_numbers(lx, "l", 2, rgb + 1)) return 0;
+    } else {
+        *lx = before;
+        fseek(lx->f, at, SEEK_SET);
+    }
+    add_light(s, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]), -1);
+    return 1;
+}
+
+/* f r g b Kd Ks Shine T ior: the material of all that follows. */
+static int nff_material(Scene *s, Lexer *lx, int *mat)
+{
+    real x[8];
+    Material m;
+    if (!nff_numbers(lx, "f", 8, x)) return 0;
+    m.color = v3(x[0], x[1], x[2]);
+    m.kd = x[3]; m.ks = x[4]; m.shine = x[5]; m.kt = x[6]; m.kl = 0;
+    m.ir = x[7] > 0 ? x[7] : 1;  /* the SPD files write 0 for opaque materials */
+    *mat = add_material(s, m);
+    return 1;
+}
+
+static int nff_sphere(Scene *s, Lexer *lx, int mat)
+{
+    real x[4];
+    if (!nff_numbers(lx, "s", 4, x)) return 0;
+    if (!(x[3] > 0)) return fail(lx->w, "sphere radius must be positive", lx->tok);
+    add_sphere(s, v3(x[0], x[1], x[2]), x[3], mat);
+    return 1;
+}
+
+/* c: base centre and radius, apex centre and radius. */
+static int nff_cone(Scene *s, Lexer *lx, int mat)
+{
+    real x[8];
+    vec base, apex;
+    if (!nff_numbers(lx, "c", 8, x)) return 0;
+    base = v3(x[0], x[1], x[2]);
+    apex = v3(x[4], x[5], x[6]);
+    if (!(x[3] >= 0 && x[7] >= 0 && x[3] + x[7] > 0)) return fail(lx->w, "cone radii must be >= 0 and not both 0", NULL);
+    if (!(dot(sub(apex, base), sub(apex, base)) > 0)) return fail(lx->w, "cone base and apex coincide", NULL);
+    add_cone(s, base, x[3], apex, x[7], mat);
+    return 1;
+}
+
+static int load_nff(Scene *s, FILE *f, Where w)
+{
+    Lexer lx;
+    real x[3];
+    int mat = -1, k, ok = 1;
+    double intensity;
+    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f);
+    while (ok && next_token(&lx)) {
+        const char *t = lx.tok;
+        if (mat < 0 && strchr("spc", t[0])) {    /* objects before any f: plain white */
+            Material m;
+            m.color = v3(1, 1, 1); m.kd = 1; m.ks = m.kt = m.kl = m.shine = 0; m.ir = 1;
+            mat = add_material(s, m);
+        }
+        if (!strcmp(t, "v")) ok = nff_view(s, &lx);
+        else if (!strcmp(t, "b")) { if ((ok = nff_numbers(&lx, t, 3, x))) s->background = v3(x[0], x[1], x[2]); }
+        else if (!strcmp(t, "l")) ok = nff_light(s, &lx);
+        else if (!strcmp(t, "f")) ok = nff_material(s, &lx, &mat);
+        else if (!strcmp(t, "s")) ok = nff_sphere(s, &lx, mat);
+        else if (!strcmp(t, "c")) ok = nff_cone(s, &lx, mat);
+        else if (!strcmp(t, "p")) ok = nff_polygon(s, &lx, 0, mat);
+        else if (!strcmp(t, "pp")) ok = nff_polygon(s, &lx, 1, mat);
+        else ok = fail(lx.w, "unknown NFF entity", t);
+    }
+    /* The SPD's suggested strength: sqrt(L) / (2 L) for each of L lights and
+     * for the ambient, so that the total stays about the same for any L. */
+    intensity = s->nlight ? sqrt((double)s->nlight) / (2.0 * s->nlight) : 0;
+    for (k = 0; k < s->nlight; k++) s->light[k].color = scale((real)intensity, s->light[k].color);
+    s->ambient = v3((real)intensity, (real)intensity, (real)intensity);
+    return ok;
+}
+
+/* The scene by its name: NFF when it ends .nff, else the sphere format. */
+static int load_scene(Scene *s, const char *file)
+{
+    Where w = { file, 0 };
+    FILE *f = fopen(file, "r");
+    size_t len = strlen(file);
+    int ok;
+    default_scene(s);
+    if (!f) return fail(w, "cannot open scene", strerror(errno));
+    ok = len > 4 && !strcmp(file + len - 4, ".nff") ? load_nff(s, f, w) : load_sph(s, f, w);
     if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
     fclose(f);
     return ok;
@@ -584,14 +1340,17 @@ static int write_ppm(const char *file, const unsigned char *img, int w, int h, i
 static void usage(FILE *to)
 {
     fputs("usage: ray [options] SCENE\n"
-          "Renders SCENE (the sphere format; see README.md) with Whitted ray tracing.\n"
+          "Renders SCENE with Whitted ray tracing: the sphere format (README.md), or\n"
+          "NFF (Eric Haines' Neutral File Format, the SPD scenes') when it ends .nff.\n"
           "  -o FILE    output PPM (default: SCENE's base name + .ppm; - for stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
           "  -n N       anti-aliasing samples per pixel (default 1)\n"
           "  -d N       recursion depth, 1 = primary rays only (default: scene's, else 5)\n"
           "  -t N       threads (default: all cores, when built with OpenMP)\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
-          "  --stats    print rays by kind, hits and time on stderr\n"
+          "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
+          "             the tree from 16 objects up)\n"
+          "  --stats    print rays by kind, hits, the tree and time on stderr\n"
           "  --help     this text\n", to);
 }
 
@@ -620,16 +1379,54 @@ static char *default_output(const char *scene)
     return out;
 }
 
+/* The kd-tree once the scene is large enough, or as --accel says. */
+static int build_tree(Scene *s, const char *accel)
+{
+    s->prims.bounds = kd_bounds;
+    s->prims.clip = kd_clip;
+    s->prims.hit = kd_hit;
+    s->prims.user = s;
+    if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
+    s->tree = kd_build(nobj(s), &s->prims);
+    if (!s->tree) { fprintf(stderr, "ray: out of memory for the kd-tree\n"); return 0; }
+    return 1;
+}
+
+static void print_stats(const Scene *s, const Stats *st, int spp, double load, double seconds)
+{
+    unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted;
+    fprintf(stderr, "scene      %d spheres, %d triangles, %d lights; read in %.3f s\n",
+            s->nsph, s->ntri, s->nlight, load);
+    fprintf(stderr, "image      %dx%d, %d spp, depth %d\n", s->w, s->h, spp, s->depth);
+    if (s->tree) {
+        kd_info k;
+        kd_describe(s->tree, &k);
+        fprintf(stderr, "kd-tree    %ld nodes, %ld leaves (%ld empty), depth %ld, %.2f objects per leaf,\n"
+                "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
+                k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf,
+                k.bytes / 1e6, k.sah_cost, k.build_seconds);
+    } else
+        fprintf(stderr, "kd-tree    none: every ray tests every object\n");
+    fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
+            rays, st->primary, st->shadow, st->reflected, st->refracted);
+    fprintf(stderr, "hits       %llu (%.1f%% of nearest-hit rays)\n", st->hits,
+            rays ? 100.0 * st->hits / (double)st->queries : 0.0);
+    fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
+            st->queries ? (double)st->tests / st->queries : 0.0,
+            st->queries ? (double)st->steps / st->queries : 0.0);
+    fprintf(stderr, "time       %.3f s, %.2f Mrays/s\n", seconds, seconds > 0 ? rays / seconds * 1e-6 : 0.0);
+}
+
 int main(int argc, char **argv)
 {
     Scene s;
     Options o = { 1, 0, 0 };
     Stats st;
-    const char *scene = NULL, *size = NULL;
+    const char *scene = NULL, *size = NULL, *accel = "auto";
     char *out = NULL, *auto_out = NULL;
     int i, depth = 0, plain = 0, stats = 0, ok;
     unsigned char *img;
-    double t0;
+    double t0, load;
 
     for (i = 1; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -641,17 +1438,20 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
         else if (!strcmp(a, "--p3")) plain = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
+        else if (!strcmp(a, "--accel") && next && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
+            accel = argv[++i];
         else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "ray: unknown option or missing argument: %s\n", a);
+            fprintf(stderr, "ray: unknown option, or a bad or missing value: %s\n", a);
             usage(stderr);
             return 2;
         } else if (scene) { fprintf(stderr, "ray: one scene only (%s and %s)\n", scene, a); return 2; }
         else scene = a;
     }
     if (!scene) { usage(stderr); return 2; }
+    load = now();
     if (!load_scene(&s, scene)) return 1;
     if (size) {
-        char *x, *end;
+        char *x, *end = NULL;
         long fw = strtol(size, &x, 10), fh = *x == 'x' ? strtol(x + 1, &end, 10) : 0;
         if (x == size || *x != 'x' || end == x + 1 || *end) {
             fprintf(stderr, "ray: -s needs WxH, like 640x480, not %s\n", size);
@@ -663,6 +1463,8 @@ int main(int argc, char **argv)
         }
     }
     if (depth) s.depth = depth;
+    if (!build_tree(&s, accel)) return 1;
+    load = now() - load;
     if (!out) out = auto_out = default_output(scene);
     o.progress = isatty(2);
 
@@ -673,19 +1475,10 @@ int main(int argc, char **argv)
     render(&s, &o, img, &st);
     t0 = now() - t0;
     ok = write_ppm(out, img, s.w, s.h, plain);
-    if (stats) {
-        unsigned long long rays = st.primary + st.shadow + st.reflected + st.refracted;
-        fprintf(stderr, "image      %dx%d, %d spp, depth %d, %d spheres, %d lights\n",
-                s.w, s.h, o.spp, s.depth, s.nsph, s.nlight);
-        fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
-                rays, st.primary, st.shadow, st.reflected, st.refracted);
-        fprintf(stderr, "hits       %llu (%.1f%% of rays), %llu intersection tests\n",
-                st.hits, rays ? 100.0 * st.hits / rays : 0.0, st.tests);
-        fprintf(stderr, "time       %.3f s, %.2f Mrays/s\n", t0, t0 > 0 ? rays / t0 * 1e-6 : 0.0);
-    }
+    if (stats) print_stats(&s, &st, o.spp, load, t0);
     free(img);
     free(auto_out);
-    free(s.sph);
-    free(s.light);
+    if (s.tree) kd_free(s.tree);
+    free(s.mat); free(s.sph); free(s.tri); free(s.vert); free(s.norm); free(s.light);
     return ok ? 0 : 1;
 }

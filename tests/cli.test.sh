@@ -58,3 +58,44 @@ grep -q "^rays .*primary.*shadow.*reflected.*refracted" "$TMP/err" && grep -q "^
 # No NaN: a scene whose glass has index 1 and sits at the eye still gives bytes.
 printf 'camera 0 0 0 0 1 0 0 0 1 60\n0 0 0 1 1 1 1 0 .5 .5 0 1\nlight 0 -5 5 1 1 1\n' > "$TMP/in.sph"
 ./ray -s 16x16 -o "$TMP/in.ppm" "$TMP/in.sph" && ok "eye inside a sphere renders" || bad "eye inside a sphere"
+
+# NFF and OBJ readers: errors as file:line: message.
+bad_nff() {
+  local name=$1 pat=$2
+  printf '%b' "$3" > "$TMP/s.nff"
+  rm -f "$TMP/out.ppm"
+  ./ray -o "$TMP/out.ppm" "$TMP/s.nff" 2> "$TMP/err"; rc=$?
+  if [ $rc -ne 0 ] && grep -qE "^$TMP/s.nff:[0-9]+: $pat" "$TMP/err" && [ ! -e "$TMP/out.ppm" ]; then
+    ok "NFF $name: $(head -1 "$TMP/err" | sed "s|$TMP/||")"
+  else
+    bad "NFF $name: exit $rc, said: $(head -1 "$TMP/err")"
+  fi
+}
+view='v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 45\nhither 1\nresolution 8 8\n'
+bad_nff "unknown entity" "unknown NFF entity: q" "$view""q 1 2 3\n"
+bad_nff "not a number" "not a number: x" "$view""s 0 0 x 1\n"
+bad_nff "file ends inside a polygon" "the file ends inside: a polygon" "$view""p 4\n0 0 0\n1 0 0\n1 1 0\n"
+bad_nff "polygon of 2 corners" "a polygon needs 3 or more corners" "$view""p 2\n0 0 0\n1 0 0\n"
+bad_nff "negative sphere radius" "sphere radius must be positive" "$view""s 0 0 0 -1\n"
+bad_nff "bad view keyword" "expected from, at, up" "v\nfrom 0 0 0\nlook 1 2 3\n"
+bad_nff "error on the right line" "" "$view""# comment\n\ns 0 0 0 1\ns 0 0 nan 1\n"
+grep -q "s.nff:11: " "$TMP/err" && ok "NFF line numbers count comments and blank lines" || bad "NFF line: $(cat "$TMP/err")"
+
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n' > "$TMP/bad.obj"
+printf 'mesh bad.obj 1 1 1 1 0 0 0 1\n' > "$TMP/m.sph"
+./ray -o "$TMP/out.ppm" "$TMP/m.sph" 2> "$TMP/err"; rc=$?
+[ $rc -ne 0 ] && grep -qE "^$TMP/bad.obj:4: vertex index out of range: 4" "$TMP/err" && [ ! -e "$TMP/out.ppm" ] \
+  && ok "OBJ index out of range: $(sed "s|$TMP/||" "$TMP/err")" || bad "OBJ index error: exit $rc, $(cat "$TMP/err")"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 zz\n' > "$TMP/bad.obj"
+./ray -o "$TMP/out.ppm" "$TMP/m.sph" 2> "$TMP/err"; rc=$?
+[ $rc -ne 0 ] && grep -qE "^$TMP/bad.obj:3: not a number: zz" "$TMP/err" \
+  && ok "OBJ not a number: $(sed "s|$TMP/||" "$TMP/err")" || bad "OBJ number error: exit $rc, $(cat "$TMP/err")"
+printf 'mesh nosuch.obj 1 1 1 1 0 0 0 1\n' > "$TMP/m.sph"
+./ray -o "$TMP/out.ppm" "$TMP/m.sph" 2> "$TMP/err"; rc=$?
+[ $rc -ne 0 ] && grep -qE "^$TMP/m.sph:1: cannot open mesh" "$TMP/err" \
+  && ok "missing OBJ named at the scene's line: $(sed "s|$TMP/||" "$TMP/err")" || bad "missing OBJ: exit $rc, $(cat "$TMP/err")"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\ng x\nf 1 2 3\n' > "$TMP/ok.obj"
+printf 'camera 0 0 -3 0 0 0 0 1 0 40\nlight 0 0 -5 1 1 1\nmesh ok.obj 1 1 1 1 0 0 0 1\n' > "$TMP/m.sph"
+./ray -s 8x8 -o "$TMP/out.ppm" "$TMP/m.sph" 2> "$TMP/err"; rc=$?
+[ $rc -eq 0 ] && [ "$(grep -c warning "$TMP/err")" = 1 ] && [ -s "$TMP/out.ppm" ] \
+  && ok "OBJ: other statements get one warning, not a failure" || bad "OBJ warning: exit $rc, $(cat "$TMP/err")"

@@ -131,6 +131,311 @@ static void test_refraction(void)
            "z=%.17g want %.17g", t.z, -d.z);
 }
 
+
+/* ---- triangles ---- */
+
+static Scene tri_scene(int cull)
+{
+    Scene s;
+    Material m;
+    memset(&m, 0, sizeof m);
+    m.color = v3(1, 1, 1);
+    m.kd = m.ir = 1;
+    default_scene(&s);
+    s.cull = cull;
+    add_material(&s, m);
+    return s;
+}
+
+static int tri(Scene *s, vec a, vec b, vec c)
+{
+    int i = add_vertex(s, a), j = add_vertex(s, b);
+    add_triangle(s, i, j, add_vertex(s, c), -1, -1, -1, 0);
+    return s->ntri - 1;
+}
+
+static void free_scene(Scene *s)
+{
+    if (s->tree) kd_free(s->tree);
+    free(s->mat); free(s->sph); free(s->tri); free(s->vert); free(s->norm); free(s->light);
+}
+
+/* Legs from 1e-8 to 1e8, the ray starting one leg above: t must be one leg.
+ * The original epsilon (|det| < 1e-6) loses every leg below 1e-3. */
+static void test_triangle_scales(void)
+{
+    double L, worst = 0;
+    int misses = 0;
+    for (L = 1e-8; L <= 1e8 * 1.01; L *= 10) {
+        Scene s = tri_scene(0);
+        real t, u, v;
+        int k = tri(&s, v3(0, 0, 0), v3(L, 0, 0), v3(0, L, 0));
+        if (!hit_triangle(&s, &s.tri[k], ray(v3(0.25 * L, 0.25 * L, L), v3(0, 0, -1)), INFINITY, &t, &u, &v))
+            misses++;
+        else if (fabs(t / L - 1) > worst)
+            worst = fabs(t / L - 1);
+        free_scene(&s);
+    }
+    report(misses == 0 && worst < 1e-15, "triangles with legs 1e-8..1e8 are hit at the right t",
+           "misses %g, worst relative error %.3g", misses, worst);
+}
+
+/* Zero-area triangles never hit and never give NaN; NaN rays hit nothing. */
+static void test_triangle_degenerate(void)
+{
+    Scene s = tri_scene(0);
+    unsigned x = 12345;
+    int k, hits = 0, nans = 0, r;
+    tri(&s, v3(0, 0, 0), v3(1, 0, 0), v3(1, 0, 0));            /* repeated vertex */
+    tri(&s, v3(0, 0, 0), v3(1, 1, 1), v3(3, 3, 3));            /* in a line */
+    tri(&s, v3(0.1, 0.2, 0.3), v3(0.1, 0.2, 0.3), v3(0.1, 0.2, 0.3)); /* a point */
+    tri(&s, v3(0, 0, 0), v3(1e-9, 1e-9, 1e-9), v3(1, 1, 1));   /* in a line, not exactly */
+    for (r = 0; r < 100000; r++)
+        for (k = 0; k < s.ntri; k++) {
+            real t = 0, u = 0, v = 0;
+            vec o, d;
+            x = x * 1664525u + 1013904223u; o.x = (x >> 8) / 16777216.0 * 4 - 2;
+            x = x * 1664525u + 1013904223u; o.y = (x >> 8) / 16777216.0 * 4 - 2;
+            x = x * 1664525u + 1013904223u; o.z = (x >> 8) / 16777216.0 * 4 - 2;
+            /* aim at a point of the degenerate triangle's line */
+            d = sub(comb((x >> 8) / 16777216.0, sub(s.vert[s.tri[k].v[2]], s.vert[s.tri[k].v[0]]),
+                         s.vert[s.tri[k].v[0]]), o);
+            hits += hit_triangle(&s, &s.tri[k], ray(o, d), INFINITY, &t, &u, &v);
+            nans += t != t || u != u || v != v;
+        }
+    report(hits == 0 && nans == 0, "degenerate triangles: 400000 rays at them, no hit, no NaN",
+           "hits %g, NaNs %g", hits, nans);
+    {
+        Scene g = tri_scene(0);
+        real t;
+        Sphere sp = sphere(0, 0, 0, 1);
+        double nan = strtod("nan", NULL);
+        int k2 = tri(&g, v3(-1, -1, 0), v3(1, -1, 0), v3(0, 1, 0));
+        int h = hit_object(&g, 0, ray(v3(0, 0, 1), v3(nan, 0, -1)), INFINITY, &t)
+                + !isinf(hit_sphere(&sp, ray(v3(0, 0, 5), v3(0, nan, -1)), 0));
+        (void)k2;
+        report(h == 0, "a ray with a NaN direction hits nothing", "hits %g (want %g)", h, 0);
+        free_scene(&g);
+    }
+    free_scene(&s);
+}
+
+static void test_triangle_culling(void)
+{
+    Scene one = tri_scene(1), two = tri_scene(0);
+    real t, u, v;
+    int front, back, both;
+    tri(&one, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));         /* normal +z */
+    tri(&two, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));
+    front = hit_triangle(&one, &one.tri[0], ray(v3(.2, .2, 1), v3(0, 0, -1)), INFINITY, &t, &u, &v);
+    back = hit_triangle(&one, &one.tri[0], ray(v3(.2, .2, -1), v3(0, 0, 1)), INFINITY, &t, &u, &v);
+    both = hit_triangle(&two, &two.tri[0], ray(v3(.2, .2, -1), v3(0, 0, 1)), INFINITY, &t, &u, &v);
+    report(front && !back && both && near(u, .2, 1e-15) && near(v, .2, 1e-15),
+           "culling branch: front only; two-sided by default; u, v right", "front %g back %g", front, back);
+    free_scene(&one);
+    free_scene(&two);
+}
+
+/* A closed mesh: a latitude-longitude sphere of radius 1, its vertices
+ * shared (as an OBJ gives them) or repeated per triangle (as NFF's
+ * polygons do), with fans of `lon` triangles at the poles. */
+static void uv_sphere(Scene *s, int lat, int lon, int shared)
+{
+    int i, j, base = s->nvert;
+    vec *p = malloc(sizeof *p * (size_t)(lat + 1) * lon);
+    for (i = 0; i <= lat; i++)
+        for (j = 0; j < lon; j++) {
+            double th = PI * i / lat, ph = 2 * PI * j / lon;
+            p[i * lon + j] = v3(sin(th) * cos(ph), sin(th) * sin(ph), cos(th));
+            if (i == 0 || i == lat) p[i * lon + j] = v3(0, 0, i ? -1 : 1);
+            if (shared) add_vertex(s, p[i * lon + j]);
+        }
+    for (i = 0; i < lat; i++)
+        for (j = 0; j < lon; j++) {
+            int a = i * lon + j, b = i * lon + (j + 1) % lon, c = a + lon, d = b + lon;
+            if (i > 0) {
+                if (shared) add_triangle(s, base + a, base + c, base + b, -1, -1, -1, 0);
+                else tri(s, p[a], p[c], p[b]);
+            }
+            if (i < lat - 1) {
+                if (shared) add_triangle(s, base + b, base + c, base + d, -1, -1, -1, 0);
+                else tri(s, p[b], p[c], p[d]);
+            }
+        }
+    free(p);
+}
+
+static double rnd(unsigned long long *x)
+{
+    *x = *x * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (*x >> 11) / 9007199254740992.0;
+}
+
+/* Rays from inside a closed mesh, aimed exactly at its vertices and at
+ * points of its edges: each must hit the mesh.  A ray through an edge or a
+ * vertex is where rounding lets a test that is not watertight leak. */
+static void test_watertight(int shared)
+{
+    Scene s = tri_scene(0);
+    Stats st;
+    unsigned long long x = 42;
+    int r, escapes = 0, n = 1000000;
+    char name[96];
+    memset(&st, 0, sizeof st);
+    uv_sphere(&s, 8, 16, shared);
+    build_tree(&s, shared ? "kd" : "none");   /* one through the tree, one through the loop */
+    for (r = 0; r < n; r++) {
+        const Triangle *t = &s.tri[(int)(rnd(&x) * s.ntri)];
+        int e = (int)(rnd(&x) * 3);
+        vec a = s.vert[t->v[e]], b = s.vert[t->v[(e + 1) % 3]], o, target;
+        double f = r % 2 ? 0 : rnd(&x);       /* half at vertices, half on edges */
+        Hit h;
+        o = v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5);
+        target = comb(f, sub(b, a), a);
+        if (!nearest_hit(&s, ray(o, unit(sub(target, o))), &h, &st)) escapes++;
+    }
+    sprintf(name, "watertight: rays at the vertices and edges of a closed mesh (%s vertices)",
+            shared ? "shared" : "repeated");
+    report(escapes == 0, name, "%g escapes of %g rays", escapes, n);
+    free_scene(&s);
+}
+
+/* The kd-tree must give what the loop gives: same object, same t, bit for
+ * bit, for a scene of spheres and triangles and rays of every awkward kind. */
+static void test_tree_matches_loop(void)
+{
+    Scene s = tri_scene(0);
+    Stats st;
+    unsigned long long x = 7;
+    int r, k, wrong = 0, n = 1000000;
+    memset(&st, 0, sizeof st);
+    uv_sphere(&s, 6, 12, 1);
+    for (k = 0; k < 60; k++) {          /* random spheres and triangles in [-3, 3]^3 */
+        vec c = v3(6 * rnd(&x) - 3, 6 * rnd(&x) - 3, 6 * rnd(&x) - 3);
+        add_sphere(&s, c, 0.05 + 0.3 * rnd(&x), 0);
+        tri(&s, c, add(c, v3(rnd(&x), rnd(&x), 0)), add(c, v3(0, rnd(&x), rnd(&x))));
+    }
+    tri(&s, v3(-4, -4, -1), v3(4, -4, -1), v3(-4, 4, -1));     /* axis-aligned: splits land on it */
+    tri(&s, v3(0, 0, 0), v3(0, 2, 0), v3(0, 0, 2));
+    build_tree(&s, "kd");
+    for (r = 0; r < n; r++) {
+        Hit a, b;
+        int ha, hb;
+        Ray ry;
+        kd_tree *tree = s.tree;
+        ry.o = v3(8 * rnd(&x) - 4, 8 * rnd(&x) - 4, 8 * rnd(&x) - 4);
+        ry.d = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5));
+        switch (r % 5) {
+        case 1: ry.d = v3(0, 0, 0); *(&ry.d.x + r / 5 % 3) = r / 15 % 2 ? 1 : -1; break; /* axis-parallel */
+        case 2: ry.o.z = -1; break;                          /* on the big triangle's plane */
+        case 3: ry.o.x = 0; ry.d.x = 0; ry.d = unit(ry.d); break; /* in the plane x = 0 */
+        case 4: ry.o = scale(0.01, ry.o); break;              /* inside the scene box */
+        }
+        ha = nearest_hit(&s, ry, &a, &st);
+        s.tree = NULL;
+        hb = nearest_hit(&s, ry, &b, &st);
+        s.tree = tree;
+        if (ha != hb || (ha && (a.obj != b.obj || a.t != b.t))) wrong++;
+    }
+    report(wrong == 0, "kd-tree = loop: same object and t for 1e6 rays (axis-parallel, in planes, inside)",
+           "%g mismatches of %g", wrong, n);
+    free_scene(&s);
+}
+
+/* ---- scene readers ---- */
+
+static const char *write_tmp(const char *name, const char *text)
+{
+    static char path[256];
+    const char *dir = getenv("TMP") ? getenv("TMP") : "/tmp";
+    FILE *f;
+    sprintf(path, "%s/%s", dir, name);
+    f = fopen(path, "w");
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+static double tri_area(const Scene *s, int k)
+{
+    const Triangle *t = &s->tri[k];
+    vec n = cross(sub(s->vert[t->v[1]], s->vert[t->v[0]]), sub(s->vert[t->v[2]], s->vert[t->v[0]]));
+    return 0.5 * sqrt(dot(n, n));
+}
+
+/* Ear clipping: a concave star and a comb (like a gear's teeth) must come
+ * out as n-2 triangles covering exactly the polygon's area, with no triangle
+ * outside it; a fan from vertex 0 gets the area wrong. */
+static void test_ear_clipping(void)
+{
+    int shape;
+    for (shape = 0; shape < 2; shape++) {
+        Scene s = tri_scene(0);
+        int vi[64], n = shape ? 40 : 16, k;
+        double area = 0, sum = 0;
+        for (k = 0; k < n; k++) {
+            double a = 2 * PI * k / n, r = shape ? (k % 4 < 2 ? 1 : 0.6) : (k % 2 ? 0.3 : 1);
+            vec p = v3(r * cos(a), 0.5, r * sin(a));            /* in the plane y = 0.5 */
+            vi[k] = add_vertex(&s, p);
+        }
+        for (k = 0; k < n; k++) {                                /* shoelace in x-z */
+            vec a = s.vert[vi[k]], b = s.vert[vi[(k + 1) % n]];
+            area += 0.5 * (a.z * b.x - a.x * b.z);
+        }
+        triangulate(&s, vi, NULL, n, 0);
+        for (k = 0; k < s.ntri; k++) sum += tri_area(&s, k);
+        report(s.ntri == n - 2 && near(sum, fabs(area), 1e-12 * fabs(area)),
+               shape ? "ear clipping a 40-gon comb: n-2 triangles, area exact" :
+                       "ear clipping a 16-point star: n-2 triangles, area exact",
+               "area of triangles %.15g, polygon %.15g", sum, fabs(area));
+        free_scene(&s);
+    }
+}
+
+/* NFF: the view angle spans the centres of the outer pixel columns. */
+static void test_nff_view(void)
+{
+    Scene s;
+    const char *f = write_tmp("view.nff",
+        "v\nfrom 0 -10 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 64 48\n"
+        "l 1 2 3\nl 4 5 6 .5 .5 .5\nf 1 0 0 1 0 0 0 0\np 3\n0 0 0\n1 0 0\n0 0 1\n"
+        "pp 3\n0 0 0 0 -1 0\n1 0 0 0 -1 0\n0 0 1 0 -1 0\ns 0 0 0 1\nc 0 0 0 1 0 0 2 0\n");
+    Ray a, b;
+    double angle;
+    int ok = load_scene(&s, f);
+    a = camera_ray(&s.cam, s.w, s.h, 0.5, 24);
+    b = camera_ray(&s.cam, s.w, s.h, 63.5, 24);
+    angle = acos(dot(a.d, b.d)) * 180 / PI;
+    report(ok && s.w == 64 && s.h == 48 && near(angle, 40, 1e-9),
+           "NFF angle spans the outer pixel centres", "%.12g deg, want %g", angle, 40);
+    report(ok && s.nlight == 2 && near(s.light[1].color.x, .5 * sqrt(2) / 4, 1e-15)
+           && near(s.ambient.x, sqrt(2) / 4, 1e-15),
+           "NFF lights: optional colour, strength sqrt(L)/2L", "light %.15g ambient %.15g",
+           s.light[1].color.x, s.ambient.x);
+    report(ok && s.nsph == 1 && s.ntri == 2 + 2 * CONE_SEGMENTS - CONE_SEGMENTS && s.tri[1].n[0] >= 0,
+           "NFF p, pp (with normals), s and c (a cone: 32 triangles)", "triangles %g, spheres %g",
+           s.ntri, s.nsph);
+    free_scene(&s);
+}
+
+/* OBJ: n-gons, negative indices, normals, and statements it skips. */
+static void test_obj(void)
+{
+    Scene s;
+    const char *obj = write_tmp("quad.obj",
+        "# a quad and a triangle\nmtllib x.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "vn 0 0 1\nvt 0 0\nusemtl red\nf 1//1 2//1 3//1 4//1\nf -4 -3 -1\n");
+    const char *sph = write_tmp("mesh.sph", "mesh quad.obj 1 1 1 1 0 0 0 1\n");
+    int ok;
+    (void)obj;
+    ok = load_scene(&s, sph);
+    report(ok && s.ntri == 3 && s.nvert == 4 && s.tri[0].n[0] == 0 && s.tri[2].n[0] < 0
+           && s.tri[2].v[2] == 3,
+           "OBJ: a quad with normals, negative indices, a mesh line", "triangles %g, vertices %g",
+           s.ntri, s.nvert);
+    free_scene(&s);
+}
+
 static void test_camera(void)
 {
     Scene s;
@@ -155,22 +460,21 @@ static void test_camera(void)
 static int acne_at_scale(double k, int *counted)
 {
     Scene s;
-    Light l;
+    Material m;
+    Light *l;
     int i, j, wrong = 0, W = 96;
     Stats st;
     real v[10];
     memset(&st, 0, sizeof st);
+    memset(&m, 0, sizeof m);
+    m.color = v3(1, 1, 1);
+    m.kd = m.ir = 1;
     default_scene(&s);
-    s.nsph = 2;
-    s.sph = calloc(2, sizeof *s.sph);
-    s.sph[0] = sphere(0, 0, -1e4 * k, 1e4 * k);
-    s.sph[1] = sphere(0, 0, k, k);
-    s.sph[0].m.ir = s.sph[1].m.ir = 1;
-    l.pos = v3(2 * k, -1 * k, 6 * k);
-    l.color = v3(1, 1, 1);
-    l.sphere = -1;
-    s.light = &l;
-    s.nlight = 1;
+    add_material(&s, m);
+    add_sphere(&s, v3(0, 0, -1e4 * k), 1e4 * k, 0);
+    add_sphere(&s, v3(0, 0, k), k, 0);
+    add_light(&s, v3(2 * k, -1 * k, 6 * k), v3(1, 1, 1), -1);
+    l = &s.light[0];
     v[0] = 0; v[1] = -8 * k; v[2] = 5 * k; v[3] = 0; v[4] = 0; v[5] = 0;
     v[6] = 0; v[7] = 0; v[8] = 1; v[9] = 50;
     set_camera(&s, (Where){ "", 0 }, v);
@@ -179,20 +483,19 @@ static int acne_at_scale(double k, int *counted)
         for (i = 0; i < W; i++) {
             Hit h;
             real e;
-            vec n, to_l, oc;
+            vec to_l, oc;
             double b, dist2, len;
             int lit, truth;
             if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &st)) continue;
-            n = h.n;
-            lit = shadow_ray(&s, &h, n, &l, &e, &st);
+            lit = shadow_ray(&s, &h, h.n, l, &e, &st);
             if (!(e > 1e-6)) continue;     /* grazing or facing away */
             /* exact: does the segment from the point to the light pass
              * through the ball (if the point is on the ground), in units of k */
-            to_l = unit(sub(l.pos, h.p));
+            to_l = unit(sub(l->pos, h.p));
             oc = sub(s.sph[1].cen, h.p);
             b = dot(oc, to_l);
             dist2 = dot(oc, oc) - b * b;
-            len = sqrt(dot(sub(l.pos, h.p), sub(l.pos, h.p)));
+            len = sqrt(dot(sub(l->pos, h.p), sub(l->pos, h.p)));
             truth = 1;
             if (h.obj == 0 && b > 0 && b < len) {
                 if (fabs(sqrt(dist2) / k - 1) < 1e-6) continue;   /* on the shadow's edge */
@@ -201,7 +504,7 @@ static int acne_at_scale(double k, int *counted)
             ++*counted;
             wrong += lit != truth;
         }
-    free(s.sph);
+    free(s.mat); free(s.sph); free(s.light);
     return wrong;
 }
 
@@ -224,6 +527,15 @@ int main(void)
     test_sphere_inside_and_miss();
     test_refraction();
     test_camera();
+    test_triangle_scales();
+    test_triangle_degenerate();
+    test_triangle_culling();
+    test_ear_clipping();
+    test_nff_view();
+    test_obj();
+    test_watertight(1);
+    test_watertight(0);
+    test_tree_matches_loop();
     test_acne();
     return failures != 0;
 }

@@ -1,0 +1,873 @@
+/* kdtree.c - a kd-tree for ray tracing over primitives it knows only through
+ * the callbacks of kdtree.h.
+ *
+ * Build: the surface area heuristic (SAH) with the O(N log N) sweep of
+ * Wald & Havran 2006, "On building fast kd-trees for ray tracing, and on doing
+ * that in O(N log N)".  The edges of every primitive's box become "events",
+ * sorted once per axis.  One linear sweep over a node's sorted events prices
+ * every candidate plane of that node; splitting the node's event lists keeps
+ * them sorted, so no level sorts again: only the primitives that the plane
+ * cuts get new (clipped) events, and those few are sorted and merged in.
+ *
+ * Traversal: Kaplan's near/far order (Kaplan 1985, "Space-tracing: a constant
+ * time ray-tracer"), written with an explicit stack as in Havran 2000 (thesis,
+ * "Heuristic Ray Shooting Algorithms").  Results equal those of a brute-force
+ * loop over all primitives, ties included (see kd_nearest).
+ */
+#include "kdtree.h"
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* The SAH cost model (MacDonald & Booth 1990; Wald & Havran 2006):
+ *     cost(split) = COST_STEP + COST_TEST * (A(L)/A(V) * nL + A(R)/A(V) * nR)
+ *     cost(leaf)  = COST_TEST * n
+ * where A is surface area: the chance that a ray through cell V also passes
+ * through a child is the ratio of their areas.  COST_STEP is one traversal
+ * step, COST_TEST one call of the hit callback; only their ratio shapes the
+ * tree, a larger COST_TEST giving deeper trees with fewer primitives per
+ * leaf and more references.  The ratio was measured, not guessed: on the
+ * 100k-triangle sphere of bench/kdbench.c, ratios 0.75, 1, 1.25, 1.5, 2, 3
+ * gave 4.3, 4.2, 4.1, 4.2, 3.9, 3.8 Mrays/s (5.2, 5.2, 5.1, 5.0, 4.9, 4.7
+ * with perfect splits): flat up to about 1.5, falling beyond.  We take 1,
+ * which also makes fewer references than larger ratios.  A step is cheap in
+ * flops but often waits for a node from memory; a test is an indirect call
+ * that cannot be inlined; both end in a hard-to-predict branch. */
+#define COST_STEP 1.0
+#define COST_TEST 1.0
+
+/* Cutting off empty space pays more than the model says: a ray that enters
+ * an empty cell leaves it at once, and it shrinks the cells that do hold
+ * primitives.  Wald & Havran 2006 scale the cost of such splits by 0.8;
+ * so do we. */
+#define EMPTY_BONUS 0.8
+
+/* Hard limit on depth, so the traversal stack can be a fixed array.  The
+ * build stops at 8 + 1.3 log2 N (below), which stays under this for any N
+ * that fits in the 30-bit indices of a node. */
+#define STACK_SIZE 64
+
+/* The traversal treats every cell as if it were grown by a margin
+ * delta = RAY_EPS * (largest coordinate of the scene box and the ray origin)
+ * on every side, and visits every cell whose grown box the ray passes
+ * through.  Plane crossings t = (s - o) / d carry rounding errors, and so do
+ * the hit callback's t and its inside tests; without the margin a hit lying
+ * on a cell boundary could be judged to lie only in the cell that does not
+ * list its primitive.  With it, the tree returns exactly what brute force
+ * returns as long as the callback's hit points lie within delta of the
+ * primitive's box: rounding errors up to ten million times those of a single
+ * double operation are covered.  The price is an occasional extra cell for
+ * rays passing within delta of a boundary. */
+#define RAY_EPS 1e-9
+
+/* ---- nodes ------------------------------------------------------------ */
+
+/* One node in 8 bytes: eight fit in a 64-byte cache line, and as the node
+ * array comes from malloc (aligned to at least 8), none straddles two.  `bits`
+ * holds the axis (0, 1, 2) or LEAF (3) in its low 2 bits and an index in the
+ * other 30.  Inner node: `split` is the plane, the index is the left child;
+ * the right child is always index + 1, so one index serves both.  Leaf:
+ * `count` primitives, listed at that index of the tree's primitive list. */
+typedef struct {
+    union {
+        float split;
+        uint32_t count;
+    } u;
+    uint32_t bits;
+} kd_node;
+
+#define LEAF 3u
+#define MAX_INDEX ((1ul << 30) - 1)
+
+/* C99 has no _Static_assert: an array of size -1 does not compile. */
+typedef char kd_node_must_be_8_bytes[sizeof(kd_node) == 8 ? 1 : -1];
+
+static int node_axis(const kd_node *n) { return (int)(n->bits & 3u); }
+static uint32_t node_index(const kd_node *n) { return n->bits >> 2; }
+
+struct kd_tree {
+    kd_node *nodes;  /* nodes[0] is the root; one block with `prims` */
+    int *prims;      /* the leaves' lists of primitive numbers */
+    double lo[3], hi[3];  /* scene box: the union of the primitives' boxes */
+    double scale;    /* largest |coordinate| of the scene box */
+    size_t bytes;
+    kd_info info;
+};
+
+/* ---- boxes -------------------------------------------------------------- */
+
+/* Boxes are kept in float, the precision of the split planes.  Rounding lo
+ * down and hi up keeps every box around its primitive; since every event and
+ * so every plane is then already a float, classifying a primitive against a
+ * plane is exact and means the same in the build and in the traversal. */
+typedef struct {
+    float lo[3], hi[3];
+} kd_box;
+
+/* Coordinates beyond the float range are clamped to it; a primitive that
+ * reaches out there (an infinite plane, say) is not supported. */
+static float round_down(double x)
+{
+    float f;
+    if (x > FLT_MAX) return FLT_MAX;
+    if (x < -FLT_MAX) return -FLT_MAX;
+    f = (float)x;
+    return (double)f > x ? nextafterf(f, -FLT_MAX) : f;
+}
+
+static float round_up(double x)
+{
+    return -round_down(-x);
+}
+
+/* Box of lo..hi, rounded outwards.  0 for NaN or lo > hi: such a primitive
+ * has no place in space and is left out of the tree. */
+static int make_box(const double lo[3], const double hi[3], kd_box *b)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        if (!(lo[a] <= hi[a])) return 0;
+        b->lo[a] = round_down(lo[a]);
+        b->hi[a] = round_up(hi[a]);
+    }
+    return 1;
+}
+
+static double box_area(const kd_box *b)
+{
+    double dx = (double)b->hi[0] - b->lo[0];
+    double dy = (double)b->hi[1] - b->lo[1];
+    double dz = (double)b->hi[2] - b->lo[2];
+    return 2 * (dx * dy + dy * dz + dz * dx);
+}
+
+static float clampf(float x, float lo, float hi)
+{
+    return x < lo ? lo : x > hi ? hi : x;
+}
+
+/* ---- events (Wald & Havran 2006) --------------------------------------- */
+
+/* At one position, ends sort before planar primitives before starts: the
+ * sweep must have counted what ends at p before it prices p. */
+enum { END = 0, PLANAR = 1, START = 2 };
+
+typedef struct {
+    float pos;
+    int type;
+    int prim;
+} kd_event;
+
+/* The events of one node, one list per axis, each sorted. */
+typedef struct {
+    kd_event *ev[3];
+    long n[3];
+    long count;  /* primitives in the node */
+} kd_list;
+
+/* Ties broken by primitive number: a total order gives the same list
+ * whatever qsort does with equal keys, so the build is deterministic. */
+static int event_cmp(const void *pa, const void *pb)
+{
+    const kd_event *a = pa, *b = pb;
+    if (a->pos != b->pos) return a->pos < b->pos ? -1 : 1;
+    if (a->type != b->type) return a->type - b->type;
+    return (a->prim > b->prim) - (a->prim < b->prim);
+}
+
+/* A zero-thickness box gives one PLANAR event instead of a start and an end
+ * at the same place: the sweep then knows it lies in the plane itself. */
+static void add_events(kd_event *ev[3], long n[3], int prim, const kd_box *b)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        kd_event *e = ev[a] + n[a];
+        if (b->lo[a] == b->hi[a]) {
+            e[0].pos = b->lo[a], e[0].type = PLANAR, e[0].prim = prim;
+            n[a] += 1;
+        } else {
+            e[0].pos = b->lo[a], e[0].type = START, e[0].prim = prim;
+            e[1].pos = b->hi[a], e[1].type = END, e[1].prim = prim;
+            n[a] += 2;
+        }
+    }
+}
+
+static void free_list(kd_list *L)
+{
+    int a;
+    for (a = 0; a < 3; a++) free(L->ev[a]), L->ev[a] = NULL;
+}
+
+static int alloc_list(kd_list *L, long cap)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        L->ev[a] = malloc((cap > 0 ? cap : 1) * sizeof(kd_event));
+        L->n[a] = 0;
+    }
+    L->count = 0;
+    if (L->ev[0] && L->ev[1] && L->ev[2]) return 1;
+    free_list(L);
+    return 0;
+}
+
+/* ---- the builder -------------------------------------------------------- */
+
+enum { LEFT = 1, RIGHT = 2, BOTH = 3 };
+
+typedef struct {
+    const kd_prims *p;
+    kd_node *nodes;
+    long nnodes, node_cap;
+    int *refs;
+    long nrefs, ref_cap;
+    unsigned char *side;  /* per primitive, while splitting one node */
+    kd_box *cur;          /* per primitive: its box inside that node */
+    int max_depth;
+    double root_area;
+    kd_info info;
+    int failed;           /* out of memory, or more than 2^30 nodes */
+} kd_builder;
+
+typedef struct {
+    int found, axis, planar_left;
+    float pos;
+    double cost;
+} kd_split;
+
+/* Expected cost of cutting v at pos, with nl and nr primitives per side. */
+static double sah(const kd_box *v, int axis, float pos, long nl, long nr,
+                  double area)
+{
+    kd_box l = *v, r = *v;
+    double cost;
+    l.hi[axis] = pos;
+    r.lo[axis] = pos;
+    cost = COST_STEP + COST_TEST * (box_area(&l) * nl + box_area(&r) * nr) / area;
+    return nl == 0 || nr == 0 ? cost * EMPTY_BONUS : cost;
+}
+
+/* Price one plane twice, with the primitives lying in it on either side
+ * (Wald & Havran 2006 keep the cheaper; on a tie, left). */
+static void consider(kd_split *best, const kd_box *v, int axis, float pos,
+                     long nl, long np, long nr, double area)
+{
+    double left = sah(v, axis, pos, nl + np, nr, area);
+    double right = sah(v, axis, pos, nl, np + nr, area);
+    double cost = left <= right ? left : right;
+    if (cost < best->cost) {
+        best->found = 1, best->axis = axis, best->pos = pos;
+        best->cost = cost, best->planar_left = left <= right;
+    }
+}
+
+/* Planes on or within a few float steps of a face of the cell are left
+ * out.  On the face, they would leave one child without volume.  Near it,
+ * they would cut off a sliver that exists only because of rounding: a vertex
+ * coordinate that is no float ends some boxes at the float above it and
+ * starts others at the float below.  A sliver has almost no surface area, so
+ * the SAH would take it as free and pile the primitives touching it into it,
+ * level after level, many times over. */
+static int well_inside(float pos, float lo, float hi)
+{
+    double gap = (fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi)) / (1 << 20);
+    return pos - (double)lo > gap && (double)hi - pos > gap;
+}
+
+/* The sweep: walking the sorted events, nl counts the primitives wholly
+ * left of the current position and nr those not yet ended. */
+static void sweep(const kd_list *L, int axis, const kd_box *v, double area,
+                  kd_split *best)
+{
+    const kd_event *e = L->ev[axis];
+    long n = L->n[axis], i = 0, nl = 0, nr = L->count;
+    while (i < n) {
+        float pos = e[i].pos;
+        long ends = 0, planars = 0, starts = 0;
+        for (; i < n && e[i].pos == pos && e[i].type == END; i++) ends++;
+        for (; i < n && e[i].pos == pos && e[i].type == PLANAR; i++) planars++;
+        for (; i < n && e[i].pos == pos && e[i].type == START; i++) starts++;
+        nr -= ends + planars;
+        if (well_inside(pos, v->lo[axis], v->hi[axis]))
+            consider(best, v, axis, pos, nl, planars, nr, area);
+        nl += starts + planars;
+    }
+}
+
+static kd_split find_split(const kd_list *L, const kd_box *v)
+{
+    kd_split best;
+    double area = box_area(v);
+    int a;
+    best.found = 0, best.axis = 0, best.planar_left = 1;
+    best.pos = 0, best.cost = HUGE_VAL;
+    if (!(area > 0)) return best;  /* a line or a point: nothing to cut */
+    for (a = 0; a < 3; a++) sweep(L, a, v, area, &best);
+    return best;
+}
+
+/* Which side of the plane each primitive goes to.  A box ending at the
+ * plane goes left, one starting at it right; one lying in it goes where the
+ * SAH put it; one crossing it goes to both. */
+static void classify(kd_builder *b, const kd_list *L, const kd_split *s)
+{
+    const kd_event *e = L->ev[s->axis];
+    long n = L->n[s->axis], i;
+    for (i = 0; i < n; i++) b->side[e[i].prim] = BOTH;
+    for (i = 0; i < n; i++) {
+        if (e[i].type == END && e[i].pos <= s->pos)
+            b->side[e[i].prim] = LEFT;
+        else if (e[i].type == START && e[i].pos >= s->pos)
+            b->side[e[i].prim] = RIGHT;
+        else if (e[i].type == PLANAR) {
+            if (e[i].pos < s->pos) b->side[e[i].prim] = LEFT;
+            else if (e[i].pos > s->pos) b->side[e[i].prim] = RIGHT;
+            else b->side[e[i].prim] = s->planar_left ? LEFT : RIGHT;
+        }
+    }
+}
+
+/* Read back the box, inside this node, of each primitive that the plane
+ * cuts: its events are all there is. */
+static void recall_boxes(kd_builder *b, const kd_list *L)
+{
+    int a;
+    long i;
+    for (a = 0; a < 3; a++) {
+        for (i = 0; i < L->n[a]; i++) {
+            const kd_event *e = &L->ev[a][i];
+            kd_box *box = &b->cur[e->prim];
+            if (b->side[e->prim] != BOTH) continue;
+            if (e->type != END) box->lo[a] = e->pos;
+            if (e->type != START) box->hi[a] = e->pos;
+        }
+    }
+}
+
+/* The part of a cut primitive inside one child cell.  With a clip callback
+ * this is the box of the primitive's geometry inside the cell, which can be
+ * far smaller than the box cut down ("perfect splits", Havran 2000); the
+ * result is kept inside the old box and the cell, for safety against a
+ * callback's rounding.  0 when nothing of the primitive is in the cell. */
+static int clip_prim(const kd_builder *b, int prim, const kd_box *cell,
+                     kd_box *out)
+{
+    kd_box old = b->cur[prim];
+    int a;
+    for (a = 0; a < 3; a++) {
+        old.lo[a] = old.lo[a] > cell->lo[a] ? old.lo[a] : cell->lo[a];
+        old.hi[a] = old.hi[a] < cell->hi[a] ? old.hi[a] : cell->hi[a];
+    }
+    *out = old;
+    if (b->p->clip) {
+        double clo[3], chi[3], lo[3], hi[3];
+        for (a = 0; a < 3; a++) clo[a] = cell->lo[a], chi[a] = cell->hi[a];
+        if (!b->p->clip(b->p->user, prim, clo, chi, lo, hi)) return 0;
+        if (!make_box(lo, hi, out)) return 1;  /* NaN: keep the old box */
+        for (a = 0; a < 3; a++) {
+            out->lo[a] = clampf(out->lo[a], old.lo[a], old.hi[a]);
+            out->hi[a] = clampf(out->hi[a], old.lo[a], old.hi[a]);
+        }
+    }
+    return 1;
+}
+
+/* Merge the events of the primitives that went wholly to one side (already
+ * sorted) with the fresh events of the cut primitives (sorted here). */
+static void merge(const kd_event *old, long n, const unsigned char *side,
+                  int want, const kd_event *fresh, long nf, kd_event *out,
+                  long *nout)
+{
+    long i = 0, j = 0, k = 0;
+    for (;;) {
+        while (i < n && side[old[i].prim] != want) i++;
+        if (i == n) break;
+        if (j < nf && event_cmp(&fresh[j], &old[i]) < 0) out[k++] = fresh[j++];
+        else out[k++] = old[i++];
+    }
+    while (j < nf) out[k++] = fresh[j++];
+    *nout = k;
+}
+
+/* Events for the cut primitives, clipped to each child: the only events
+ * that need sorting after the first sort (Wald & Havran 2006). */
+static int cut_events(kd_builder *b, const kd_list *L, const kd_box *vl,
+                      const kd_box *vr, kd_list *fl, kd_list *fr)
+{
+    const kd_event *e = L->ev[0];
+    long i, ncut = 0;
+    int a;
+    for (i = 0; i < L->n[0]; i++)
+        if (e[i].type != END && b->side[e[i].prim] == BOTH) ncut++;
+    if (!alloc_list(fl, 2 * ncut)) return 0;
+    if (!alloc_list(fr, 2 * ncut)) return free_list(fl), 0;
+    for (i = 0; i < L->n[0]; i++) {
+        kd_box box;
+        if (e[i].type == END || b->side[e[i].prim] != BOTH) continue;
+        if (clip_prim(b, e[i].prim, vl, &box))
+            add_events(fl->ev, fl->n, e[i].prim, &box), fl->count++;
+        if (clip_prim(b, e[i].prim, vr, &box))
+            add_events(fr->ev, fr->n, e[i].prim, &box), fr->count++;
+    }
+    for (a = 0; a < 3; a++) {
+        qsort(fl->ev[a], fl->n[a], sizeof(kd_event), event_cmp);
+        qsort(fr->ev[a], fr->n[a], sizeof(kd_event), event_cmp);
+    }
+    return 1;
+}
+
+/* Events of the primitives going wholly to one side, on axis a; on axis 0
+ * counting starts and planars only gives the number of primitives. */
+static long count_side(const kd_builder *b, const kd_list *L, int a, int want,
+                       int prims_only)
+{
+    long i, k = 0;
+    for (i = 0; i < L->n[a]; i++) {
+        const kd_event *e = &L->ev[a][i];
+        if (prims_only && e->type == END) continue;
+        k += b->side[e->prim] == want;
+    }
+    return k;
+}
+
+/* Split the sorted event lists of a node into sorted lists for its two
+ * children in time linear in their length (plus the sort of the few cut
+ * primitives). */
+static int split_lists(kd_builder *b, const kd_list *L, const kd_split *s,
+                       const kd_box *vl, const kd_box *vr, kd_list *left,
+                       kd_list *right)
+{
+    kd_list fl, fr;
+    int a, ok = 1;
+    classify(b, L, s);
+    recall_boxes(b, L);
+    if (!cut_events(b, L, vl, vr, &fl, &fr)) return 0;
+    for (a = 0; a < 3; a++) {
+        long nl = count_side(b, L, a, LEFT, 0) + fl.n[a];
+        long nr = count_side(b, L, a, RIGHT, 0) + fr.n[a];
+        left->ev[a] = malloc((nl + 1) * sizeof(kd_event));
+        right->ev[a] = malloc((nr + 1) * sizeof(kd_event));
+        ok = ok && left->ev[a] && right->ev[a];
+    }
+    for (a = 0; ok && a < 3; a++) {
+        merge(L->ev[a], L->n[a], b->side, LEFT, fl.ev[a], fl.n[a],
+              left->ev[a], &left->n[a]);
+        merge(L->ev[a], L->n[a], b->side, RIGHT, fr.ev[a], fr.n[a],
+              right->ev[a], &right->n[a]);
+    }
+    left->count = count_side(b, L, 0, LEFT, 1) + fl.count;
+    right->count = count_side(b, L, 0, RIGHT, 1) + fr.count;
+    free_list(&fl), free_list(&fr);
+    if (!ok) free_list(left), free_list(right);
+    return ok;
+}
+
+/* ---- nodes and leaves --------------------------------------------------- */
+
+/* Room for two adjacent nodes, the children of one inner node. */
+static long new_pair(kd_builder *b)
+{
+    long at = b->nnodes;
+    if (at + 2 > (long)MAX_INDEX) return b->failed = 1, -1;
+    if (at + 2 > b->node_cap) {
+        long cap = 2 * b->node_cap + 16;
+        kd_node *grown = realloc(b->nodes, cap * sizeof(kd_node));
+        if (!grown) return b->failed = 1, -1;
+        b->nodes = grown, b->node_cap = cap;
+    }
+    b->nnodes += 2;
+    return at;
+}
+
+static int int_cmp(const void *pa, const void *pb)
+{
+    int a = *(const int *)pa, b = *(const int *)pb;
+    return (a > b) - (a < b);
+}
+
+/* A leaf lists its primitives in increasing order: deterministic, and kind
+ * to the caches when primitives are stored in a sensible order. */
+static void make_leaf(kd_builder *b, long at, const kd_list *L)
+{
+    const kd_event *e = L->ev[0];
+    long i, start = b->nrefs;
+    if (start + L->count > (long)MAX_INDEX) {
+        b->failed = 1;
+        return;
+    }
+    if (start + L->count > b->ref_cap) {
+        long cap = 2 * b->ref_cap + L->count + 16;
+        int *grown = realloc(b->refs, cap * sizeof(int));
+        if (!grown) {
+            b->failed = 1;
+            return;
+        }
+        b->refs = grown, b->ref_cap = cap;
+    }
+    for (i = 0; i < L->n[0]; i++)
+        if (e[i].type != END) b->refs[b->nrefs++] = e[i].prim;
+    if (L->count > 1) qsort(b->refs + start, L->count, sizeof(int), int_cmp);
+    b->nodes[at].u.count = (uint32_t)L->count;
+    b->nodes[at].bits = (uint32_t)start << 2 | LEAF;
+}
+
+/* The shape and SAH cost of the tree, gathered as it is built. */
+static void note_node(kd_builder *b, const kd_box *v, int depth, long leaf_prims)
+{
+    double weight = b->root_area > 0 ? box_area(v) / b->root_area : 1.0;
+    b->info.nodes++;
+    if (depth > b->info.max_depth) b->info.max_depth = depth;
+    if (leaf_prims < 0) {
+        b->info.sah_cost += COST_STEP * weight;
+        return;
+    }
+    b->info.leaves++;
+    b->info.empty_leaves += leaf_prims == 0;
+    b->info.prim_refs += leaf_prims;
+    b->info.sah_cost += COST_TEST * leaf_prims * weight;
+}
+
+/* Build the subtree of node `at` over the events L (which it frees) in cell
+ * v.  A node becomes a leaf when
+ *   - it holds no primitive: nothing to gain;
+ *   - it is at the depth limit, 8 + 1.3 log2 N: a guard against piles of
+ *     overlapping primitives that no plane separates, where each split would
+ *     copy them all to both sides (the rule of thumb of Pharr & Humphreys'
+ *     pbrt); it also bounds the traversal's stack;
+ *   - no candidate plane lies well inside the cell (see well_inside), or
+ *   - the best split costs at least as much as the leaf (COST_TEST * n): the
+ *     automatic termination of the SAH (Wald & Havran 2006). */
+static void build_node(kd_builder *b, long at, kd_list *L, const kd_box *v,
+                       int depth)
+{
+    kd_split s;
+    kd_list left, right;
+    kd_box vl = *v, vr = *v;
+    long child;
+    s.found = 0;
+    if (L->count > 0 && depth < b->max_depth) s = find_split(L, v);
+    if (!s.found || s.cost >= COST_TEST * L->count) {
+        note_node(b, v, depth, L->count);
+        make_leaf(b, at, L);
+        free_list(L);
+        return;
+    }
+    vl.hi[s.axis] = s.pos;
+    vr.lo[s.axis] = s.pos;
+    if (!split_lists(b, L, &s, &vl, &vr, &left, &right)) {
+        b->failed = 1;
+        free_list(L);
+        return;
+    }
+    free_list(L);
+    child = new_pair(b);
+    if (child < 0) {
+        free_list(&left), free_list(&right);
+        return;
+    }
+    note_node(b, v, depth, -1);
+    b->nodes[at].u.split = s.pos;
+    b->nodes[at].bits = (uint32_t)child << 2 | (uint32_t)s.axis;
+    build_node(b, child, &left, &vl, depth + 1);
+    build_node(b, child + 1, &right, &vr, depth + 1);
+}
+
+/* The events of all primitives, sorted once: the only full sort. */
+static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
+{
+    int i, a;
+    memset(scene, 0, sizeof *scene);
+    if (!alloc_list(L, 2 * (long)n)) return 0;
+    for (i = 0; i < n; i++) {
+        double lo[3], hi[3];
+        kd_box box;
+        b->p->bounds(b->p->user, i, lo, hi);
+        if (!make_box(lo, hi, &box)) continue;
+        for (a = 0; a < 3; a++) {
+            if (L->count == 0 || box.lo[a] < scene->lo[a]) scene->lo[a] = box.lo[a];
+            if (L->count == 0 || box.hi[a] > scene->hi[a]) scene->hi[a] = box.hi[a];
+        }
+        add_events(L->ev, L->n, i, &box);
+        L->count++;
+    }
+    for (a = 0; a < 3; a++) qsort(L->ev[a], L->n[a], sizeof(kd_event), event_cmp);
+    return 1;
+}
+
+/* Move nodes and lists into one block: one allocation to free, one range of
+ * memory for the traversal, and a single byte string to compare. */
+static kd_tree *finish(kd_builder *b, const kd_box *scene)
+{
+    kd_tree *t = malloc(sizeof *t);
+    size_t nb = b->nnodes * sizeof(kd_node), rb = b->nrefs * sizeof(int);
+    int a;
+    if (!t) return NULL;
+    t->nodes = malloc(nb + rb);
+    if (!t->nodes) return free(t), NULL;
+    memcpy(t->nodes, b->nodes, nb);
+    t->prims = (int *)(t->nodes + b->nnodes);
+    if (rb) memcpy(t->prims, b->refs, rb);
+    t->bytes = nb + rb;
+    t->scale = 0;
+    for (a = 0; a < 3; a++) {
+        t->lo[a] = scene->lo[a], t->hi[a] = scene->hi[a];
+        if (fabs(t->lo[a]) > t->scale) t->scale = fabs(t->lo[a]);
+        if (fabs(t->hi[a]) > t->scale) t->scale = fabs(t->hi[a]);
+    }
+    t->info = b->info;
+    t->info.bytes = t->bytes;
+    t->info.prims_per_leaf = t->info.leaves > t->info.empty_leaves
+        ? (double)t->info.prim_refs / (t->info.leaves - t->info.empty_leaves) : 0;
+    return t;
+}
+
+kd_tree *kd_build(int n, const kd_prims *p)
+{
+    clock_t start = clock();
+    kd_builder b;
+    kd_list L;
+    kd_box scene;
+    kd_tree *t = NULL;
+    memset(&b, 0, sizeof b);
+    b.p = p;
+    if (n < 0) n = 0;
+    b.side = malloc((size_t)n + 1);
+    b.cur = malloc(((size_t)n + 1) * sizeof(kd_box));
+    if (b.side && b.cur && root_list(&b, n, &L, &scene)) {
+        b.max_depth = n > 1 ? (int)(8 + 1.3 * log2((double)n)) : 8;
+        if (b.max_depth > STACK_SIZE) b.max_depth = STACK_SIZE;
+        b.root_area = box_area(&scene);
+        b.nodes = malloc(16 * sizeof(kd_node));
+        b.node_cap = 16, b.nnodes = 1;
+        if (b.nodes) build_node(&b, 0, &L, &scene, 0);
+        else free_list(&L);
+        if (b.nodes && !b.failed) t = finish(&b, &scene);
+    }
+    free(b.side), free(b.cur), free(b.nodes), free(b.refs);
+    if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
+    return t;
+}
+
+void kd_free(kd_tree *t)
+{
+    if (t) free(t->nodes), free(t);
+}
+
+void kd_describe(const kd_tree *t, kd_info *info)
+{
+    if (t) *info = t->info;
+    else memset(info, 0, sizeof *info);
+}
+
+const void *kd_bytes(const kd_tree *t, size_t *size)
+{
+    *size = t->bytes;
+    return t->nodes;
+}
+
+long kd_splits(const kd_tree *t, int *axis, double *pos, long max)
+{
+    long i, k = 0;
+    for (i = 0; i < t->info.nodes; i++) {
+        const kd_node *n = &t->nodes[i];
+        if (node_axis(n) == (int)LEAF) continue;
+        if (k < max) axis[k] = node_axis(n), pos[k] = n->u.split;
+        k++;
+    }
+    return k;
+}
+
+/* ---- traversal ---------------------------------------------------------- */
+
+/* The ray as the walk needs it.  inv is 1/dir, and +-infinity for +-0; a
+ * zero component is "flat": the ray runs parallel to that axis's planes.
+ * neg says which way the ray runs along each axis, from the sign bit, so
+ * that -0 counts as negative like its 1/d = -inf.  pad[a] is the margin
+ * delta (see RAY_EPS) in units of t along axis a.  A denormal component can
+ * make inv and pad infinite and the plane crossings NaN; every comparison
+ * below is written so that NaN means "visit", which is always safe. */
+typedef struct {
+    const double *org, *dir;
+    double inv[3], pad[3];
+    int neg[3], flat[3];
+    double delta;
+    double t0, t1;  /* the part of the ray inside the (grown) scene box */
+} kd_ray;
+
+/* A cell still to visit, with the stretch of the ray inside it. */
+typedef struct {
+    uint32_t node;
+    double t0, t1;
+} kd_todo;
+
+static int finite3(const double v[3])
+{
+    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+/* Clip the ray to one slab of the grown scene box.  A flat axis needs no
+ * division: the ray is inside the slab for every t or for none. */
+static int clip_slab(const kd_tree *t, kd_ray *r, int a)
+{
+    double lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta, ta, tb;
+    if (r->flat[a]) return r->org[a] >= lo && r->org[a] <= hi;
+    ta = ((r->neg[a] ? hi : lo) - r->org[a]) * r->inv[a];
+    tb = ((r->neg[a] ? lo : hi) - r->org[a]) * r->inv[a];
+    if (ta > r->t0) r->t0 = ta;
+    if (tb < r->t1) r->t1 = tb;
+    return 1;
+}
+
+/* Set up the ray and clip it to the scene box (the slab test).  0 when it
+ * misses the box, and for NaN or infinite input. */
+static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
+                     double tmin, double tmax, kd_ray *r)
+{
+    double scale = t->scale;
+    int a;
+    if (!finite3(org) || !finite3(dir)) return 0;
+    r->org = org, r->dir = dir, r->t0 = tmin, r->t1 = tmax;
+    for (a = 0; a < 3; a++) {
+        r->neg[a] = copysign(1.0, dir[a]) < 0;
+        r->inv[a] = dir[a] != 0 ? 1.0 / dir[a] : r->neg[a] ? -HUGE_VAL : HUGE_VAL;
+        r->flat[a] = dir[a] == 0;
+        if (fabs(org[a]) > scale) scale = fabs(org[a]);
+    }
+    r->delta = RAY_EPS * scale;
+    for (a = 0; a < 3; a++) {
+        r->pad[a] = r->flat[a] ? 0 : r->delta * fabs(r->inv[a]);
+        if (!clip_slab(t, r, a)) return 0;
+    }
+    return r->t0 <= r->t1;  /* false for NaN in tmin or tmax */
+}
+
+static void push(kd_todo *stack, int *n, uint32_t node, double t0, double t1)
+{
+    stack[*n].node = node, stack[*n].t0 = t0, stack[*n].t1 = t1;
+    ++*n;
+}
+
+/* One inner node of Kaplan's near/far walk.  "near" is the child the ray
+ * meets first (by the sign of its direction, so any tmin works): the walk
+ * goes on into it, and remembers the far child if the ray reaches it too.
+ * The ray crosses the plane at ts, give or take pad: it leaves the grown
+ * near cell at ts + pad and enters the grown far cell at ts - pad.  A ray
+ * parallel to the plane stays in the cell of its origin; if it lies in the
+ * plane (or within delta of it) it runs along both cells, and both get the
+ * whole stretch: a primitive touching the plane from one side is listed on
+ * that side only, and the ray can hit it. */
+static uint32_t step(const kd_node *nd, const kd_ray *r, double *t0,
+                     double *t1, kd_todo *stack, int *n)
+{
+    int a = node_axis(nd);
+    uint32_t near = node_index(nd) + r->neg[a];
+    uint32_t far = node_index(nd) + 1 - r->neg[a];
+    double ds = nd->u.split - r->org[a], ts, pad = r->pad[a];
+    if (r->flat[a]) {
+        if (fabs(ds) > r->delta) return node_index(nd) + (ds < 0);  /* origin's side */
+        push(stack, n, far, *t0, *t1);
+        return near;
+    }
+    ts = ds * r->inv[a];
+    if (ts - pad > *t1) return near;  /* leaves the cell before the plane */
+    if (ts + pad < *t0) return far;   /* crossed the plane before entering */
+    push(stack, n, far, ts - pad > *t0 ? ts - pad : *t0, *t1);
+    if (ts + pad < *t1) *t1 = ts + pad;
+    return near;
+}
+
+/* Call the hit callback on a leaf's primitives.  Nearest: keep the lowest
+ * t, and on equal t the lower primitive number, as the brute-force loop
+ * would; the callback gets tmax = the best t so far, inclusive, so that it
+ * reports such ties.  Any-hit: the first hit will do. */
+static int test_leaf(const kd_tree *t, const kd_node *nd, const kd_prims *p,
+                     const void *ray, double tmin, int any, double *best_t,
+                     int best, unsigned long long *tests)
+{
+    const int *list = t->prims + node_index(nd);
+    uint32_t k, n = nd->u.count;
+    for (k = 0; k < n; k++) {
+        int i = list[k];
+        double th;
+        ++*tests;
+        if (!p->hit(p->user, i, ray, tmin, *best_t, &th)) continue;
+        if (any) return i;
+        if (th < *best_t || (th == *best_t && (best < 0 || i < best)))
+            *best_t = th, best = i;
+    }
+    return best;
+}
+
+/* Take the next cell from the stack, skipping those the ray enters only
+ * beyond the best hit: no primitive there can be hit before it, as every
+ * hit point lies in a (grown) cell listing its primitive.  This is Kaplan's
+ * rule "stop once the hit lies inside the cell just searched", as then every
+ * cell left lies beyond it; a hit found in a leaf but lying past that leaf's
+ * exit does not stop the walk, and stays the best so far.  Cells are checked
+ * one by one rather than all dropped at once because a ray lying in a plane
+ * leaves cells on the stack that it enters as early as the current one.
+ * Returns -1 when no cell is left. */
+static long pop(const kd_todo *stack, int *n, double best_t)
+{
+    while (*n > 0) {
+        --*n;
+        if (!(best_t < stack[*n].t0)) return *n;
+    }
+    return -1;
+}
+
+/* The walk shared by kd_nearest (any = 0) and kd_any (any = 1). */
+static int walk(const kd_tree *t, const kd_prims *p, const kd_ray *r,
+                const void *ray, double tmin, int any, double *best_t,
+                kd_counters *c)
+{
+    kd_todo stack[STACK_SIZE];
+    int n = 0, best = -1;
+    uint32_t node = 0;
+    double t0 = r->t0, t1 = r->t1;
+    unsigned long long steps = 0, tests = 0;
+    for (;;) {
+        const kd_node *nd = &t->nodes[node];
+        long next;
+        steps++;
+        if (node_axis(nd) != (int)LEAF) {
+            node = step(nd, r, &t0, &t1, stack, &n);
+            continue;
+        }
+        best = test_leaf(t, nd, p, ray, tmin, any, best_t, best, &tests);
+        if (any && best >= 0) break;
+        next = pop(stack, &n, *best_t);
+        if (next < 0) break;
+        node = stack[next].node, t0 = stack[next].t0, t1 = stack[next].t1;
+    }
+    if (c) c->steps += steps, c->tests += tests;
+    return best;
+}
+
+int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
+               const double dir[3], const void *ray, double tmin,
+               double *tmax, kd_counters *c)
+{
+    kd_ray r;
+    double best_t = *tmax;
+    int i;
+    if (c) c->rays++;
+    if (!t || !setup_ray(t, org, dir, tmin, *tmax, &r)) return -1;
+    i = walk(t, p, &r, ray, tmin, 0, &best_t, c);
+    if (i >= 0) *tmax = best_t;
+    return i;
+}
+
+int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
+           const double dir[3], const void *ray, double tmin, double tmax,
+           kd_counters *c)
+{
+    kd_ray r;
+    if (c) c->rays++;
+    if (!t || !setup_ray(t, org, dir, tmin, tmax, &r)) return 0;
+    return walk(t, p, &r, ray, tmin, 1, &tmax, c) >= 0;
+}

@@ -1,0 +1,789 @@
+/* test_kdtree.c - kd_nearest and kd_any against a brute-force loop.
+ *
+ *     test_kdtree SCENE [RAYS]
+ *
+ * SCENE is one of: soup mesh grid same flat empty one.  Prints one line per
+ * check, "PASS ..." or "FAIL ...", and exits 1 if any check failed.  RAYS
+ * (default 1000000, or $KD_RAYS) rays are shot per scene; each must give the
+ * same primitive and bitwise the same t as the loop
+ *     for i in 0..n-1: if hit(i, tmin, best_t) and t < best_t: best = i
+ * (a tie in t keeps the lower index), and kd_any (on every other ray) must
+ * agree with a loop that stops at the first hit.  For long runs: $KD_SCALE
+ * multiplies the scenes' sizes, $KD_SEED picks other random scenes and rays.
+ *
+ * The test scenes put their vertices on coarse dyadic grids, and most
+ * degenerate rays use grid origins and small directions, so that the
+ * triangle test below computes those rays' predicates without rounding:
+ * rays along edges, through vertices, in triangle planes and in split
+ * planes then meet the geometry exactly, which is where trees go wrong.
+ */
+#include "../kdtree.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define PI 3.14159265358979323846
+
+enum { TRI, SPHERE };
+
+typedef struct {
+    int kind;
+    double v[3][3];  /* TRI: the corners; SPHERE: v[0] centre, v[1][0] radius */
+    double n[3];     /* TRI: (v1 - v0) x (v2 - v0) */
+} prim;
+
+typedef struct {
+    const char *name;
+    prim *p;
+    int n;
+    int use_clip;
+    double grid;     /* origins of degenerate rays lie on this grid */
+    int small_dirs;  /* degenerate rays use integer directions */
+} scene;
+
+typedef struct {
+    double o[3], d[3];
+} ray;
+
+/* ---- vectors and random numbers -------------------------------------- */
+
+static void sub(const double a[3], const double b[3], double r[3])
+{
+    r[0] = a[0] - b[0], r[1] = a[1] - b[1], r[2] = a[2] - b[2];
+}
+
+static double dot(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void crossp(const double a[3], const double b[3], double r[3])
+{
+    r[0] = a[1] * b[2] - a[2] * b[1];
+    r[1] = a[2] * b[0] - a[0] * b[2];
+    r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* d . (b x c), the signed volume that tells on which side of the line
+ * through b and c (seen from the ray origin) the ray passes. */
+static double triple(const double d[3], const double b[3], const double c[3])
+{
+    double bc[3];
+    crossp(b, c, bc);
+    return dot(d, bc);
+}
+
+/* Scenes are this many times their usual size ($KD_SCALE, for long runs). */
+static double scale = 1;
+
+static unsigned long long rng_state = 88172645463325252ull;
+
+static unsigned long long rnd(void)  /* xorshift64*, deterministic */
+{
+    rng_state ^= rng_state >> 12;
+    rng_state ^= rng_state << 25;
+    rng_state ^= rng_state >> 27;
+    return rng_state * 2685821657736338717ull;
+}
+
+static double unif(double a, double b)  /* uniform in [a, b) */
+{
+    return a + (b - a) * (double)(rnd() >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static int irand(int n)  /* 0..n-1 */
+{
+    return (int)(rnd() % (unsigned long long)n);
+}
+
+static double on_grid(double a, double b, double step)  /* multiple of step */
+{
+    return step * floor(unif(a, b) / step);
+}
+
+static double snap(double x, double step)  /* nearest multiple of step */
+{
+    return step * floor(x / step + 0.5);
+}
+
+static double signed_zero(void)
+{
+    return rnd() & 1 ? 0.0 : -0.0;
+}
+
+static void random_dir(double d[3])
+{
+    double len;
+    do {
+        d[0] = unif(-1, 1), d[1] = unif(-1, 1), d[2] = unif(-1, 1);
+        len = dot(d, d);
+    } while (len > 1 || len < 1e-6);
+    len = sqrt(len);
+    d[0] /= len, d[1] /= len, d[2] /= len;
+}
+
+/* ---- the primitives and their callbacks -------------------------------- */
+
+/* Triangle: the three edge tests share their products with the neighbour
+ * across each edge (b x c = -(c x b) exactly), so no ray slips between two
+ * triangles; hits on edges and vertices count (closed triangles). */
+static int hit_tri(const prim *t, const ray *r, double tmin, double tmax,
+                   double *out)
+{
+    double a[3], b[3], c[3], w0, w1, w2, den, num, th;
+    den = dot(t->n, r->d);
+    if (den == 0) return 0;  /* parallel to the plane, or lying in it */
+    sub(t->v[0], r->o, a);
+    num = dot(t->n, a);
+    if (tmin >= 0 && !(num > 0 ? den > 0 : num < 0 && den < 0))
+        return 0;  /* t <= 0 <= tmin, known without the division */
+    th = num / den;
+    if (!(th > tmin && th <= tmax && th < HUGE_VAL)) return 0;  /* not at infinity */
+    sub(t->v[1], r->o, b), sub(t->v[2], r->o, c);
+    w0 = triple(r->d, b, c), w1 = triple(r->d, c, a), w2 = triple(r->d, a, b);
+    if ((w0 < 0 || w1 < 0 || w2 < 0) && (w0 > 0 || w1 > 0 || w2 > 0)) return 0;
+    *out = th;
+    return 1;
+}
+
+static int hit_sphere(const prim *s, const ray *r, double tmin, double tmax,
+                      double *out)
+{
+    double oc[3], a, b, c, disc, root, th;
+    sub(r->o, s->v[0], oc);
+    a = dot(r->d, r->d);
+    b = dot(oc, r->d);
+    c = dot(oc, oc) - s->v[1][0] * s->v[1][0];
+    disc = b * b - a * c;
+    if (disc < 0 || a == 0) return 0;
+    root = sqrt(disc);
+    th = (-b - root) / a;
+    if (!(th > tmin && th <= tmax)) th = (-b + root) / a;
+    if (!(th > tmin && th <= tmax && th < HUGE_VAL)) return 0;
+    *out = th;
+    return 1;
+}
+
+static int hit(void *user, int i, const void *rv, double tmin, double tmax,
+               double *t)
+{
+    const prim *p = &((const scene *)user)->p[i];
+    return p->kind == TRI ? hit_tri(p, rv, tmin, tmax, t)
+                          : hit_sphere(p, rv, tmin, tmax, t);
+}
+
+static void bounds(void *user, int i, double lo[3], double hi[3])
+{
+    const prim *p = &((const scene *)user)->p[i];
+    int a;
+    for (a = 0; a < 3; a++) {
+        if (p->kind == TRI) {
+            lo[a] = fmin(p->v[0][a], fmin(p->v[1][a], p->v[2][a]));
+            hi[a] = fmax(p->v[0][a], fmax(p->v[1][a], p->v[2][a]));
+        } else {  /* rounded outwards by one step: c - r may round up */
+            lo[a] = nextafter(p->v[0][a] - p->v[1][0], -HUGE_VAL);
+            hi[a] = nextafter(p->v[0][a] + p->v[1][0], HUGE_VAL);
+        }
+    }
+}
+
+/* Cut a polygon (n corners) by the plane x[axis] = s, keeping the side
+ * where sign * (x - s) >= 0 (Sutherland-Hodgman). */
+static int cut(double (*in)[3], int n, double (*out)[3], int axis, double s,
+               double sign)
+{
+    int i, k = 0;
+    for (i = 0; i < n; i++) {
+        const double *a = in[i], *b = in[(i + 1) % n];
+        double da = sign * (a[axis] - s), db = sign * (b[axis] - s);
+        if (da >= 0) memcpy(out[k++], a, sizeof(double[3]));
+        if ((da < 0 && db > 0) || (da > 0 && db < 0)) {
+            double f = da / (da - db);
+            int j;
+            for (j = 0; j < 3; j++) out[k][j] = a[j] + f * (b[j] - a[j]);
+            out[k++][axis] = s;
+        }
+    }
+    return k;
+}
+
+/* Perfect splits: the box of the part of a triangle inside a cell.  The
+ * corners made by cutting carry rounding errors, so the cut box is widened
+ * by far more than those, except where it ends at an original corner. */
+static int clip(void *user, int i, const double blo[3], const double bhi[3],
+                double lo[3], double hi[3])
+{
+    const prim *p = &((const scene *)user)->p[i];
+    double poly[2][12][3], tlo[3], thi[3], tol;
+    int n = 3, a, k, cur = 0;
+    bounds(user, i, tlo, thi);
+    if (p->kind == SPHERE) {
+        for (a = 0; a < 3; a++) {
+            lo[a] = fmax(tlo[a], blo[a]), hi[a] = fmin(thi[a], bhi[a]);
+            if (lo[a] > hi[a]) return 0;
+        }
+        return 1;
+    }
+    memcpy(poly[0], p->v, sizeof p->v);
+    tol = 1e-12 * (fabs(tlo[0]) + fabs(tlo[1]) + fabs(tlo[2]) + fabs(thi[0])
+                   + fabs(thi[1]) + fabs(thi[2]));
+    for (a = 0; a < 3 && n > 0; a++) {
+        n = cut(poly[cur], n, poly[1 - cur], a, blo[a] - tol, 1), cur = 1 - cur;
+        if (n > 0) n = cut(poly[cur], n, poly[1 - cur], a, bhi[a] + tol, -1), cur = 1 - cur;
+    }
+    if (n == 0) return 0;
+    for (a = 0; a < 3; a++) {
+        lo[a] = hi[a] = poly[cur][0][a];
+        for (k = 1; k < n; k++) {
+            lo[a] = fmin(lo[a], poly[cur][k][a]);
+            hi[a] = fmax(hi[a], poly[cur][k][a]);
+        }
+        if (lo[a] != tlo[a]) lo[a] -= tol;
+        if (hi[a] != thi[a]) hi[a] += tol;
+    }
+    return 1;
+}
+
+/* ---- scenes -------------------------------------------------------------- */
+
+static prim make_tri(const double a[3], const double b[3], const double c[3])
+{
+    prim t;
+    double e1[3], e2[3];
+    t.kind = TRI;
+    memcpy(t.v[0], a, sizeof t.v[0]);
+    memcpy(t.v[1], b, sizeof t.v[1]);
+    memcpy(t.v[2], c, sizeof t.v[2]);
+    sub(b, a, e1), sub(c, a, e2);
+    crossp(e1, e2, t.n);
+    return t;
+}
+
+static prim *alloc_prims(int n)
+{
+    prim *p = calloc(n > 0 ? n : 1, sizeof(prim));
+    if (!p) exit(2);
+    return p;
+}
+
+/* Random triangles with corners on a 1/64 grid in [0,8]^3, some long and
+ * thin (to give perfect splits work), and some spheres. */
+static void make_soup(scene *s)
+{
+    int i, nt = (int)(100 * scale), ns = (int)(20 * scale), a, k;
+    s->n = nt + ns, s->p = alloc_prims(s->n);
+    for (i = 0; i < nt; i++) {
+        double v[3][3], c[3], size = i % 10 == 0 ? 6 : unif(0.1, 1.5);
+        for (a = 0; a < 3; a++) c[a] = unif(0, 8);
+        for (k = 0; k < 3; k++)
+            for (a = 0; a < 3; a++)
+                v[k][a] = snap(fmax(0, fmin(8, c[a] + unif(-size, size))), 1.0 / 64);
+        s->p[i] = make_tri(v[0], v[1], v[2]);
+    }
+    for (; i < s->n; i++) {
+        s->p[i].kind = SPHERE;
+        for (a = 0; a < 3; a++) s->p[i].v[0][a] = on_grid(0.5, 7.5, 1.0 / 64);
+        s->p[i].v[1][0] = on_grid(0.1, 0.8, 1.0 / 64) + 1.0 / 64;
+    }
+    s->use_clip = 1, s->grid = 1.0 / 64, s->small_dirs = 0;
+}
+
+/* A closed triangle mesh of a sphere (latitude-longitude), corners rounded
+ * to a 1/256 grid; built without the clip callback. */
+static void make_mesh(scene *s)
+{
+    int nu = (int)(16 * sqrt(scale)), nv = (int)(10 * sqrt(scale)), i, j, k = 0;
+    double (*v)[3] = malloc(sizeof(double[3]) * (nu * (nv + 1)));
+    if (!v) exit(2);
+    for (j = 0; j <= nv; j++)
+        for (i = 0; i < nu; i++) {
+            double th = PI * j / nv, ph = 2 * PI * i / nu, *p = v[j * nu + i];
+            p[0] = snap(2 * sin(th) * cos(ph), 1.0 / 256) + 3;
+            p[1] = snap(2 * sin(th) * sin(ph), 1.0 / 256) + 3;
+            p[2] = snap(2 * cos(th), 1.0 / 256) + 3;
+        }
+    s->p = alloc_prims(2 * nu * (nv - 1));
+    for (j = 0; j < nv; j++)
+        for (i = 0; i < nu; i++) {
+            double *a = v[j * nu + i], *b = v[j * nu + (i + 1) % nu];
+            double *c = v[(j + 1) * nu + i], *d = v[(j + 1) * nu + (i + 1) % nu];
+            if (j > 0) s->p[k++] = make_tri(a, c, b);
+            if (j < nv - 1) s->p[k++] = make_tri(b, c, d);
+        }
+    free(v);
+    s->n = k, s->use_clip = 0, s->grid = 1.0 / 256, s->small_dirs = 0;
+}
+
+/* Axis-aligned rectangles on an integer lattice in [0,6]^3, two triangles
+ * each, some of them repeated: splits fall on lattice planes, rays along
+ * lattice lines run along edges and through corners. */
+static void make_grid(scene *s)
+{
+    int q, nq = (int)(120 * scale), k = 0;
+    s->p = alloc_prims(2 * nq);
+    for (q = 0; q < nq; q++) {
+        double v[4][3];
+        int ax = irand(3), u = (ax + 1) % 3, w = (ax + 2) % 3, c;
+        int u0 = irand(6), w0 = irand(6), du = 1 + irand(2), dw = 1 + irand(2);
+        if (q % 7 == 6) {  /* an exact copy of an earlier rectangle */
+            int from = 2 * irand(q);
+            s->p[k] = s->p[from], s->p[k + 1] = s->p[from + 1];
+            k += 2;
+            continue;
+        }
+        c = irand(7);
+        v[0][ax] = v[1][ax] = v[2][ax] = v[3][ax] = c;
+        v[0][u] = u0, v[0][w] = w0;
+        v[1][u] = u0 + du, v[1][w] = w0;
+        v[2][u] = u0 + du, v[2][w] = w0 + dw;
+        v[3][u] = u0, v[3][w] = w0 + dw;
+        s->p[k++] = make_tri(v[0], v[1], v[2]);
+        s->p[k++] = make_tri(v[0], v[2], v[3]);
+    }
+    s->n = k, s->use_clip = 1, s->grid = 0.5, s->small_dirs = 1;
+}
+
+/* 10,000 copies of one triangle: one leaf, every hit a 10,000-way tie. */
+static void make_same(scene *s)
+{
+    double a[3] = {1, 1, 1}, b[3] = {3, 1.5, 2}, c[3] = {1.5, 3, 2.5};
+    int i;
+    s->n = 10000, s->p = alloc_prims(s->n);
+    for (i = 0; i < s->n; i++) s->p[i] = make_tri(a, b, c);
+    s->use_clip = 1, s->grid = 1.0 / 64, s->small_dirs = 0;
+}
+
+/* Every triangle in the plane z = 3/8: all boxes have zero thickness. */
+static void make_flat(scene *s)
+{
+    int i, k, a;
+    s->n = (int)(200 * scale), s->p = alloc_prims(s->n);
+    for (i = 0; i < s->n; i++) {
+        double v[3][3], c[2];
+        c[0] = unif(0, 8), c[1] = unif(0, 8);
+        for (k = 0; k < 3; k++) {
+            for (a = 0; a < 2; a++) v[k][a] = on_grid(c[a] - 0.7, c[a] + 0.7, 1.0 / 64);
+            v[k][2] = 0.375;
+        }
+        s->p[i] = make_tri(v[0], v[1], v[2]);
+    }
+    s->use_clip = 1, s->grid = 1.0 / 64, s->small_dirs = 0;
+}
+
+static void make_one(scene *s)
+{
+    double a[3] = {0, 0, 0}, b[3] = {1, 0, 0.5}, c[3] = {0, 1, 0.25};
+    s->n = 1, s->p = alloc_prims(1);
+    s->p[0] = make_tri(a, b, c);
+    s->use_clip = 1, s->grid = 1.0 / 64, s->small_dirs = 1;
+}
+
+static int make_scene(const char *name, scene *s)
+{
+    memset(s, 0, sizeof *s);
+    s->name = name;
+    if (!strcmp(name, "soup")) make_soup(s);
+    else if (!strcmp(name, "mesh")) make_mesh(s);
+    else if (!strcmp(name, "grid")) make_grid(s);
+    else if (!strcmp(name, "same")) make_same(s);
+    else if (!strcmp(name, "flat")) make_flat(s);
+    else if (!strcmp(name, "one")) make_one(s);
+    else if (!strcmp(name, "empty")) s->p = alloc_prims(0), s->grid = 0.5;
+    else return 0;
+    return 1;
+}
+
+/* ---- rays ---------------------------------------------------------------- */
+
+typedef struct {
+    double lo[3], hi[3];
+} box3;
+
+static void scene_box(const scene *s, box3 *b)
+{
+    int i, a;
+    for (a = 0; a < 3; a++) b->lo[a] = 0, b->hi[a] = s->n ? 0 : 1;
+    for (i = 0; i < s->n; i++) {
+        double lo[3], hi[3];
+        bounds((void *)s, i, lo, hi);
+        for (a = 0; a < 3; a++) {
+            if (i == 0 || lo[a] < b->lo[a]) b->lo[a] = lo[a];
+            if (i == 0 || hi[a] > b->hi[a]) b->hi[a] = hi[a];
+        }
+    }
+}
+
+typedef struct {
+    int *axis;
+    double *pos;
+    long n;
+} splits;
+
+/* A point in the scene box grown by `grow` of its size on every side; on
+ * the scene's grid when `exact`. */
+static void point_in(const scene *s, const box3 *b, double grow, int exact,
+                     double p[3])
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        double size = b->hi[a] - b->lo[a] + 1;
+        double lo = b->lo[a] - grow * size, hi = b->hi[a] + grow * size;
+        p[a] = exact ? on_grid(lo, hi, s->grid) : unif(lo, hi);
+    }
+}
+
+/* A point on primitive i; with `exact`, at barycentric coordinates in
+ * eighths, so that it lies on the triangle without rounding. */
+static void point_on(const scene *s, int i, int exact, double p[3])
+{
+    const prim *t = &s->p[i];
+    double u, v, d[3];
+    int a;
+    if (t->kind == SPHERE) {
+        random_dir(d);
+        for (a = 0; a < 3; a++) p[a] = t->v[0][a] + t->v[1][0] * d[a];
+        return;
+    }
+    u = exact ? irand(9) / 8.0 : unif(0, 1);
+    v = exact ? irand(9) / 8.0 : unif(0, 1);
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    for (a = 0; a < 3; a++)
+        p[a] = t->v[0][a] + u * (t->v[1][a] - t->v[0][a]) + v * (t->v[2][a] - t->v[0][a]);
+}
+
+static void small_dir(double d[3])
+{
+    do {
+        d[0] = irand(7) - 3, d[1] = irand(7) - 3, d[2] = irand(7) - 3;
+    } while (d[0] == 0 && d[1] == 0 && d[2] == 0);
+}
+
+static void degenerate_dir(const scene *s, double d[3])
+{
+    if (s->small_dirs || rnd() % 2) small_dir(d);
+    else random_dir(d);
+}
+
+/* Mostly +0 or -0, sometimes a component so small that the ray is
+ * parallel to within rounding (down to the smallest denormal). */
+static double zero_or_tiny(void)
+{
+    static const double tiny[4] = {1e-20, 1e-300, 1e-310, 4.9406564584124654e-324};
+    double sign;
+    if (rnd() % 4) return signed_zero();
+    sign = rnd() & 1 ? 1 : -1;
+    return sign * tiny[irand(4)];
+}
+
+/* Along an axis: one component +-1 (or +-3), the others (nearly) zero. */
+static void axis_dir(double d[3], int axis)
+{
+    int a;
+    for (a = 0; a < 3; a++) d[a] = zero_or_tiny();
+    d[axis] = rnd() & 1 ? 1 : -1;
+    if (rnd() % 4 == 0) d[axis] *= 3;
+}
+
+enum { GENERAL, AIMED, VERTEX, AXIS, SPLIT, INPLANE, INSIDE, SMALL, KINDS };
+static const char *const kind_name[KINDS] = {
+    "general", "aimed", "vertex", "axis", "split-plane", "in-plane", "inside",
+    "small-dir"
+};
+
+static void ray_split(const scene *s, const box3 *b, const splits *sp, ray *r)
+{
+    long k = (long)(rnd() % (unsigned long long)sp->n);
+    int a = sp->axis[k];
+    point_in(s, b, 0.2, 1, r->o);
+    r->o[a] = sp->pos[k];
+    switch (irand(3)) {
+    case 0: random_dir(r->d); break;
+    case 1: degenerate_dir(s, r->d), r->d[a] = zero_or_tiny(); break;  /* in the plane */
+    default: axis_dir(r->d, irand(3));
+    }
+}
+
+/* A ray lying in the plane of a triangle: origin and direction built from
+ * the edge vectors with small dyadic factors, so both lie in it exactly. */
+static void ray_inplane(const scene *s, int i, ray *r)
+{
+    const prim *t = &s->p[i];
+    double e1[3], e2[3], al = irand(13) / 4.0 - 1, be = irand(13) / 4.0 - 1;
+    int a, m, n;
+    do m = irand(5) - 2, n = irand(5) - 2; while (m == 0 && n == 0);
+    sub(t->v[1], t->v[0], e1), sub(t->v[2], t->v[0], e2);
+    for (a = 0; a < 3; a++) {
+        r->o[a] = t->v[0][a] + al * e1[a] + be * e2[a];
+        r->d[a] = m * e1[a] + n * e2[a];
+    }
+}
+
+static void vertex_target(const scene *s, double p[3])
+{
+    const prim *t = &s->p[irand(s->n)];
+    if (t->kind == TRI) memcpy(p, t->v[irand(3)], sizeof(double[3]));
+    else memcpy(p, t->v[0], sizeof(double[3]));
+}
+
+/* The kind of ray number k: every kind in turn.  Among the identical
+ * triangles, where each ray that reaches them costs 10,000 tests, only every
+ * 40th ray is of a special kind, and the general rays start far away. */
+static int kind_of(const scene *s, long k)
+{
+    if (strcmp(s->name, "same")) return (int)(k % KINDS);
+    return k % 40 ? GENERAL : (int)(k / 40 % KINDS);
+}
+
+/* Ray number k of the test. */
+static int make_ray(const scene *s, const box3 *b, const splits *sp, long k,
+                    ray *r, double *tmin, double *tmax)
+{
+    int kind = kind_of(s, k), a;
+    double target[3], far = strcmp(s->name, "same") ? 0.5 : 10;
+    if (kind == SPLIT && sp->n == 0) kind = AXIS;
+    if ((kind == AIMED || kind == VERTEX) && s->n == 0) kind = GENERAL;
+    if (kind == INPLANE && (s->n == 0 || s->p[k / KINDS % s->n].kind != TRI))
+        kind = SMALL;
+    *tmin = 0;
+    switch (kind) {
+    case GENERAL: point_in(s, b, far, 0, r->o), random_dir(r->d); break;
+    case AIMED:
+        point_in(s, b, 0.5, 0, r->o), a = irand(s->n);
+        point_on(s, a, rnd() & 1, target);
+        sub(target, r->o, r->d);
+        break;
+    case VERTEX:
+        point_in(s, b, 0.5, 1, r->o), vertex_target(s, target);
+        sub(target, r->o, r->d);
+        break;
+    case AXIS: point_in(s, b, 0.2, 1, r->o), axis_dir(r->d, irand(3)); break;
+    case SPLIT: ray_split(s, b, sp, r); break;
+    case INPLANE: ray_inplane(s, (int)(k / KINDS % s->n), r); break;
+    case INSIDE:  /* from inside the box, or from a point on a surface */
+        if (s->n && rnd() & 1) point_on(s, irand(s->n), 1, r->o), *tmin = 1e-9;
+        else point_in(s, b, 0, rnd() & 1, r->o);
+        degenerate_dir(s, r->d);
+        break;
+    default: point_in(s, b, 0.5, 1, r->o), small_dir(r->d);
+    }
+    if (r->d[0] == 0 && r->d[1] == 0 && r->d[2] == 0) r->d[0] = 1;
+    *tmax = HUGE_VAL;
+    if (rnd() % 8 == 0) {  /* a segment instead of a ray */
+        double diag = 0;
+        for (a = 0; a < 3; a++) diag += b->hi[a] - b->lo[a];
+        *tmax = unif(0, 2) * diag / sqrt(dot(r->d, r->d));
+    }
+    return kind;
+}
+
+/* ---- brute force ----------------------------------------------------- */
+
+static int brute_nearest(const scene *s, const ray *r, double tmin, double *tmax)
+{
+    double best_t = *tmax, t;
+    int i, best = -1;
+    for (i = 0; i < s->n; i++)
+        if (hit((void *)s, i, r, tmin, best_t, &t)
+            && (t < best_t || (t == best_t && (best < 0 || i < best))))
+            best_t = t, best = i;
+    if (best >= 0) *tmax = best_t;
+    return best;
+}
+
+static int brute_any(const scene *s, const ray *r, double tmin, double tmax)
+{
+    double t;
+    int i;
+    for (i = 0; i < s->n; i++)
+        if (hit((void *)s, i, r, tmin, tmax, &t)) return 1;
+    return 0;
+}
+
+/* In the scene of identical triangles every primitive gives the same
+ * answer as primitive 0 (same numbers, same code), so the loop's answer is
+ * primitive 0's; the full loop is still run on every 1000th ray. */
+static int reference_nearest(const scene *s, const ray *r, double tmin,
+                             double *tmax, long k)
+{
+    double t;
+    if (strcmp(s->name, "same") || k % 1000 == 0)
+        return brute_nearest(s, r, tmin, tmax);
+    if (!hit((void *)s, 0, r, tmin, *tmax, &t)) return -1;
+    *tmax = t;
+    return 0;
+}
+
+static int reference_any(const scene *s, const ray *r, double tmin,
+                         double tmax, long k)
+{
+    double t;
+    if (strcmp(s->name, "same") || k % 1000 == 0) return brute_any(s, r, tmin, tmax);
+    return hit((void *)s, 0, r, tmin, tmax, &t);
+}
+
+/* ---- checks ---------------------------------------------------------- */
+
+static int failures = 0;
+
+static void report(int ok, const char *fmt, const char *name, const char *what)
+{
+    printf("%s %s %s: %s\n", ok ? "PASS" : "FAIL", what, name, fmt);
+    failures += !ok;
+}
+
+static void show_mismatch(const char *what, int kind, const ray *r, double tmin,
+                          double tmax, int want, double wt, int got, double gt)
+{
+    fprintf(stderr, "%s mismatch (%s): org %a %a %a dir %a %a %a tmin %a tmax %a:"
+            " brute %d t=%a, tree %d t=%a\n", what, kind_name[kind],
+            r->o[0], r->o[1], r->o[2], r->d[0], r->d[1], r->d[2], tmin, tmax,
+            want, wt, got, gt);
+}
+
+/* Shape of the tree, and the 8-byte node: the block kd_bytes returns is
+ * exactly 8 bytes per node plus one int per primitive reference. */
+static void check_shape(const scene *s, const kd_tree *t)
+{
+    kd_info in;
+    char msg[400];
+    long inner = kd_splits(t, NULL, NULL, 0);
+    size_t size;
+    double guard = 8 + 1.3 * log2(s->n > 1 ? s->n : 1);
+    int ok;
+    kd_describe(t, &in);
+    kd_bytes(t, &size);
+    ok = in.nodes == 2 * in.leaves - 1 && inner == in.nodes - in.leaves
+         && in.max_depth <= guard && size == in.bytes
+         && in.bytes == 8 * (size_t)in.nodes + sizeof(int) * (size_t)in.prim_refs;
+    sprintf(msg, "%d prims, %ld nodes, %ld leaves (%ld empty), depth %ld "
+            "(guard %.1f), %ld refs, %.2f prims/leaf, %lu bytes "
+            "(8 per node), SAH %.2f, built in %.4f s", s->n, in.nodes,
+            in.leaves, in.empty_leaves, in.max_depth, guard, in.prim_refs,
+            in.prims_per_leaf, (unsigned long)in.bytes, in.sah_cost,
+            in.build_seconds);
+    report(ok, msg, s->name, "tree");
+}
+
+static void check_determinism(const scene *s, const kd_prims *p, const kd_tree *t)
+{
+    kd_tree *again = kd_build(s->n, p);
+    size_t n1, n2;
+    const void *b1 = kd_bytes(t, &n1), *b2;
+    char msg[200];
+    int ok;
+    if (!again) {
+        report(0, "second build failed", s->name, "deterministic");
+        return;
+    }
+    b2 = kd_bytes(again, &n2);
+    ok = n1 == n2 && memcmp(b1, b2, n1) == 0;
+    sprintf(msg, "two builds, %lu and %lu bytes, %s", (unsigned long)n1,
+            (unsigned long)n2, ok ? "identical" : "DIFFERENT");
+    report(ok, msg, s->name, "deterministic");
+    kd_free(again);
+}
+
+static splits get_splits(const kd_tree *t)
+{
+    splits sp;
+    sp.n = kd_splits(t, NULL, NULL, 0);
+    sp.axis = malloc((sp.n + 1) * sizeof(int));
+    sp.pos = malloc((sp.n + 1) * sizeof(double));
+    if (!sp.axis || !sp.pos) exit(2);
+    kd_splits(t, sp.axis, sp.pos, sp.n);
+    return sp;
+}
+
+/* The tmax for kd_any: unbounded, exactly at the nearest hit (the bound is
+ * inclusive), just before it, or anywhere. */
+static double any_tmax(int nearest, double t, double tmax)
+{
+    switch (rnd() % 4) {
+    case 0: return HUGE_VAL;
+    case 1: return nearest >= 0 ? t : tmax;
+    case 2: return nearest >= 0 ? nextafter(t, -HUGE_VAL) : tmax;
+    default: return tmax == HUGE_VAL ? unif(0, 20) : unif(0, tmax);
+    }
+}
+
+static void check_rays(const scene *s, const kd_prims *p, const kd_tree *t, long nrays)
+{
+    box3 b;
+    splits sp = get_splits(t);
+    kd_counters c = {0, 0, 0};
+    long k, bad_near = 0, bad_any = 0, hits = 0, anys = 0, anyrays = 0;
+    long per_kind[KINDS] = {0}, bad_kind[KINDS] = {0};
+    char msg[600], *m = msg;
+    clock_t start = clock();
+    int j;
+    scene_box(s, &b);
+    for (k = 0; k < nrays; k++) {
+        ray r;
+        double tmin, tmax, want_t, got_t, ta;
+        int kind = make_ray(s, &b, &sp, k, &r, &tmin, &tmax), want, got;
+        per_kind[kind]++;
+        want_t = got_t = tmax;
+        want = reference_nearest(s, &r, tmin, &want_t, k);
+        got = kd_nearest(t, p, r.o, r.d, &r, tmin, &got_t, &c);
+        hits += want >= 0;
+        if (want != got || memcmp(&want_t, &got_t, sizeof(double))) {
+            if (bad_near++ < 5) show_mismatch("nearest", kind, &r, tmin, tmax, want, want_t, got, got_t);
+            bad_kind[kind]++;
+        }
+        if (k % 2) continue;  /* kd_any on every other ray */
+        anyrays++;
+        ta = any_tmax(want, want_t, tmax);
+        want = reference_any(s, &r, tmin, ta, k);
+        got = kd_any(t, p, r.o, r.d, &r, tmin, ta, &c);
+        anys += want;
+        if (want != got) {
+            if (bad_any++ < 5) show_mismatch("any", kind, &r, tmin, ta, want, 0, got, 0);
+            bad_kind[kind]++;
+        }
+    }
+    m += sprintf(m, "%ld rays, %ld hit, %ld mismatches; %.2f steps and %.2f "
+                 "tests per ray (brute force: %d); %.1f s; by kind:", nrays, hits,
+                 bad_near, (double)c.steps / c.rays, (double)c.tests / c.rays,
+                 s->n, (double)(clock() - start) / CLOCKS_PER_SEC);
+    for (j = 0; j < KINDS; j++)
+        m += sprintf(m, " %s %ld/%ld", kind_name[j], bad_kind[j], per_kind[j]);
+    report(bad_near == 0 && c.rays == (unsigned long long)(nrays + anyrays), msg, s->name, "nearest");
+    sprintf(msg, "%ld rays, %ld blocked, %ld mismatches%s", anyrays, anys, bad_any,
+            strcmp(s->name, "same") ? "" : " (full loop on every 1000th ray)");
+    report(bad_any == 0, msg, s->name, "any");
+    free(sp.axis), free(sp.pos);
+}
+
+int main(int argc, char **argv)
+{
+    scene s;
+    kd_prims p;
+    kd_tree *t;
+    long nrays = 1000000;
+    const char *env = getenv("KD_RAYS");
+    if (env) nrays = atol(env);
+    env = getenv("KD_SEED");  /* other scenes and rays, for long runs */
+    if (env) rng_state += 0x9E3779B97F4A7C15ull * (unsigned long long)atol(env);
+    env = getenv("KD_SCALE");
+    if (env) scale = atof(env);
+    if (!(scale >= 0.1)) scale = 0.1;
+    if (argc > 2) nrays = atol(argv[2]);
+    if (argc < 2 || !make_scene(argv[1], &s)) {
+        fprintf(stderr, "usage: test_kdtree soup|mesh|grid|same|flat|empty|one [rays]\n");
+        return 2;
+    }
+    p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s;
+    t = kd_build(s.n, &p);
+    if (!t) {
+        report(0, "kd_build returned NULL", s.name, "tree");
+        return 1;
+    }
+    check_shape(&s, t);
+    check_determinism(&s, &p, t);
+    check_rays(&s, &p, t, nrays);
+    kd_free(t);
+    free(s.p);
+    return failures != 0;
+}
