@@ -101,6 +101,10 @@ typedef struct { vec color; real kd, ks, kt, kl, ir, shine; } Material;
 
 typedef struct { vec cen; real rad; int mat; } Sphere;
 
+/* An open cone or cylinder (NFF's `c`): no end caps.  The radius runs from
+ * rb at the base to ra at the other end, along the unit axis. */
+typedef struct { vec base, axis; real len, rb, ra; int mat; } Cone;
+
 /* Vertices and normals are indices into the scene's shared arrays, so two
  * triangles that share an edge share its exact coordinates. */
 typedef struct {
@@ -124,6 +128,7 @@ typedef struct {
 typedef struct {
     Material *mat;  int nmat, capmat;
     Sphere *sph;    int nsph, capsph;
+    Cone *cone;     int ncone, capcone;
     Triangle *tri;  int ntri, captri;
     vec *vert;      int nvert, capvert;
     vec *norm;      int nnorm, capnorm;
@@ -136,8 +141,19 @@ typedef struct {
     kd_prims prims;
 } Scene;
 
-/* Objects are numbered spheres first, then triangles. */
-static int nobj(const Scene *s) { return s->nsph + s->ntri; }
+/* Objects are numbered spheres first, then cones, then triangles. */
+enum { SPHERE, CONE, TRIANGLE };
+static int nobj(const Scene *s) { return s->nsph + s->ncone + s->ntri; }
+
+/* The kind of object i, and (in *k) its index within its own kind. */
+static int kind(const Scene *s, int i, int *k)
+{
+    if (i < s->nsph) { *k = i; return SPHERE; }
+    i -= s->nsph;
+    if (i < s->ncone) { *k = i; return CONE; }
+    *k = i - s->ncone;
+    return TRIANGLE;
+}
 
 typedef struct { vec o, d; } Ray;
 
@@ -182,6 +198,53 @@ static real hit_sphere(const Sphere *s, Ray r, real tmin)
     if (t0 > tmin) return t0;
     if (t1 > tmin) return t1;
     return INFINITY;
+}
+
+/* ------------------------------------------------------- cone intersection */
+
+/* Smallest t > tmin where the ray meets the open cone's side, or INFINITY.
+ * A point at height h = (p - base).axis lies on the side when its distance
+ * from the axis is the radius there, rb + k h, with k the slope (ra - rb)/len,
+ * and 0 <= h <= len.  Squaring gives a quadratic A t^2 + 2B t + C = 0 in the
+ * ray's t; both roots come out without cancellation as for the sphere (q and
+ * C/q), and each is kept only if its height lies on the cone.  A cylinder is
+ * the case k = 0. */
+static real hit_cone(const Cone *c, Ray r, real tmin)
+{
+    vec q = sub(r.o, c->base);
+    real k = (c->ra - c->rb) / c->len;
+    real qh = dot(q, c->axis), dh = dot(r.d, c->axis);
+    vec qx = comb(-qh, c->axis, q), dx = comb(-dh, c->axis, r.d); /* across the axis */
+    real rq = c->rb + k * qh;                   /* radius at the origin's height */
+    real A = dot(dx, dx) - k * k * dh * dh;
+    real B = dot(qx, dx) - rq * k * dh;
+    real C = dot(qx, qx) - rq * rq;
+    real disc = B * B - A * C, root[2], qq;
+    int i;
+    if (A == 0) {                               /* parallel to a line of the cone */
+        if (B == 0) return INFINITY;
+        root[0] = root[1] = -C / (2 * B);
+    } else {
+        if (!(disc >= 0)) return INFINITY;
+        qq = -(B + (B >= 0 ? sqrt(disc) : -sqrt(disc)));
+        root[0] = qq / A;
+        root[1] = qq != 0 ? C / qq : root[0];
+        if (root[0] > root[1]) { real tt = root[0]; root[0] = root[1]; root[1] = tt; }
+    }
+    for (i = 0; i < 2; i++) {
+        real h = qh + root[i] * dh;
+        if (root[i] > tmin && h >= 0 && h <= c->len) return root[i];
+    }
+    return INFINITY;
+}
+
+/* The outward normal at p: away from the axis, tilted by the slope. */
+static vec cone_normal(const Cone *c, vec p)
+{
+    vec q = sub(p, c->base), radial = comb(-dot(q, c->axis), c->axis, q);
+    real k = (c->ra - c->rb) / c->len;
+    if (!(dot(radial, radial) > 0)) return scale(-1, c->axis); /* the apex itself */
+    return unit(comb(-k, c->axis, unit(radial)));
 }
 
 /* --------------------------------------------------- triangle intersection */
@@ -290,26 +353,35 @@ static int degenerate(vec a, vec b, vec c)
 static int hit_object(const Scene *s, int i, Ray r, real tmax, real *t)
 {
     real u, v;
-    if (i < s->nsph) {
-        *t = hit_sphere(&s->sph[i], r, 0);
-        return *t <= tmax && *t < INFINITY;     /* INFINITY is a miss */
+    int k;
+    switch (kind(s, i, &k)) {
+    case SPHERE: *t = hit_sphere(&s->sph[k], r, 0); break;
+    case CONE: *t = hit_cone(&s->cone[k], r, 0); break;
+    default: return hit_triangle(s, &s->tri[k], r, tmax, t, &u, &v);
     }
-    return hit_triangle(s, &s->tri[i - s->nsph], r, tmax, t, &u, &v);
+    return *t <= tmax && *t < INFINITY;         /* INFINITY is a miss */
 }
 
 /* The point, normals and material of the hit on object i at t. */
 static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
 {
+    int k, what = kind(s, i, &k);
     h->t = t;
     h->obj = i;
-    if (i < s->nsph) {
-        const Sphere *o = &s->sph[i];
+    if (what == SPHERE) {
+        const Sphere *o = &s->sph[k];
         h->p = comb(t, r.d, r.o);
         h->n = h->ng = unit(sub(h->p, o->cen));
         h->mat = o->mat;
         h->size = maxabs(h->p) + maxabs(o->cen) + o->rad + maxabs(r.o);
+    } else if (what == CONE) {
+        const Cone *c = &s->cone[k];
+        h->p = comb(t, r.d, r.o);
+        h->n = h->ng = cone_normal(c, h->p);
+        h->mat = c->mat;
+        h->size = maxabs(h->p) + maxabs(c->base) + c->len + c->rb + c->ra + maxabs(r.o);
     } else {
-        const Triangle *tr = &s->tri[i - s->nsph];
+        const Triangle *tr = &s->tri[k];
         vec a = s->vert[tr->v[0]], b = s->vert[tr->v[1]], c = s->vert[tr->v[2]];
         real u, v, tt;
         hit_triangle(s, tr, r, INFINITY, &tt, &u, &v);
@@ -328,41 +400,52 @@ static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
     }
 }
 
+/* Grows the box [lo, hi] (count points so far) to take in a disc of
+ * radius r about centre c, square to the unit vector n: along each axis the
+ * disc reaches r sqrt(1 - n_axis^2). */
+static void box_disc(double lo[3], double hi[3], int count, vec c, vec n, real r)
+{
+    double cc[3], nn[3];
+    int a;
+    cc[0] = c.x; cc[1] = c.y; cc[2] = c.z;
+    nn[0] = n.x; nn[1] = n.y; nn[2] = n.z;
+    for (a = 0; a < 3; a++) {
+        double e = r * sqrt(fmax(0, 1 - nn[a] * nn[a]));
+        if (count == 0 || cc[a] - e < lo[a]) lo[a] = cc[a] - e;
+        if (count == 0 || cc[a] + e > hi[a]) hi[a] = cc[a] + e;
+    }
+}
+
 /* The kd-tree sees objects only through these three callbacks. */
 static void kd_bounds(void *user, int i, double lo[3], double hi[3])
 {
     const Scene *s = user;
-    int k;
-    if (i < s->nsph) {
-        const Sphere *o = &s->sph[i];
-        lo[0] = o->cen.x - o->rad; lo[1] = o->cen.y - o->rad; lo[2] = o->cen.z - o->rad;
-        hi[0] = o->cen.x + o->rad; hi[1] = o->cen.y + o->rad; hi[2] = o->cen.z + o->rad;
+    int k, j;
+    switch (kind(s, i, &k)) {
+    case SPHERE:   /* a sphere's box is that of its three great discs */
+        for (j = 0; j < 3; j++) box_disc(lo, hi, j, s->sph[k].cen, v3(j == 0, j == 1, j == 2), s->sph[k].rad);
+        return;
+    case CONE:
+        box_disc(lo, hi, 0, s->cone[k].base, s->cone[k].axis, s->cone[k].rb);
+        box_disc(lo, hi, 1, comb(s->cone[k].len, s->cone[k].axis, s->cone[k].base), s->cone[k].axis, s->cone[k].ra);
         return;
     }
-    for (k = 0; k < 3; k++) {
-        vec p = s->vert[s->tri[i - s->nsph].v[k]];
-        double c[3];
-        int a;
-        c[0] = p.x; c[1] = p.y; c[2] = p.z;
-        for (a = 0; a < 3; a++) {
-            if (k == 0 || c[a] < lo[a]) lo[a] = c[a];
-            if (k == 0 || c[a] > hi[a]) hi[a] = c[a];
-        }
-    }
+    for (j = 0; j < 3; j++)        /* a vertex: a disc of radius 0 */
+        box_disc(lo, hi, j, s->vert[s->tri[k].v[j]], v3(1, 0, 0), 0);
 }
 
 /* The box of the part of a triangle inside [blo, bhi]: the triangle clipped
  * by the box's six planes (Sutherland and Hodgman, 1974), so that the tree
  * can split a long triangle exactly ("perfect splits", Havran 2000).  A
- * sphere is simply boxed and cut to the box. */
+ * sphere or a cone is simply boxed and cut to the box. */
 static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
                    double lo[3], double hi[3])
 {
     const Scene *s = user;
     double poly[2][9][3];
-    int n = 3, k, a, side, cur = 0;
+    int n = 3, k, a, side, cur = 0, t;
     kd_bounds(user, i, lo, hi);
-    if (i < s->nsph) {
+    if (kind(s, i, &t) != TRIANGLE) {
         for (a = 0; a < 3; a++) {
             if (lo[a] < blo[a]) lo[a] = blo[a];
             if (hi[a] > bhi[a]) hi[a] = bhi[a];
@@ -371,7 +454,7 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
         return 1;
     }
     for (k = 0; k < 3; k++) {
-        vec p = s->vert[s->tri[i - s->nsph].v[k]];
+        vec p = s->vert[s->tri[t].v[k]];
         poly[0][k][0] = p.x; poly[0][k][1] = p.y; poly[0][k][2] = p.z;
     }
     for (a = 0; a < 3; a++)
@@ -382,7 +465,7 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
             double (*out)[3] = poly[1 - cur];
             for (k = 0; k < n; k++) {
                 const double *p = in[k], *q = in[(k + 1) % n];
-                double dp = sign * (p[0 + a] - plane), dq = sign * (q[a] - plane);
+                double dp = sign * (p[a] - plane), dq = sign * (q[a] - plane);
                 if (dp >= 0) { memcpy(out[m++], p, sizeof out[0]); }
                 if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) {
                     double f = dp / (dp - dq);
@@ -850,31 +933,27 @@ static void triangulate(Scene *s, const int *vi, const int *ni, int n, int mat)
     free(idx);
 }
 
-/* NFF's cones and cylinders (`c`, open at both ends) as triangles with
- * smooth normals.  32 segments keep the silhouette within 0.5% of the radius
- * (1 - cos(pi/32)), under a pixel for the SPD scenes at 512x512, and let the
- * kd-tree handle them like any mesh. */
-#define CONE_SEGMENTS 32
 static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
 {
-    vec axis = sub(apex, base), ax = unit(axis), u, v;
-    real len = sqrt(dot(axis, axis));
-    int k, first = s->nvert, nfirst = s->nnorm;
-    u = unit(cross(ax, fabs(ax.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
-    v = cross(ax, u);
-    for (k = 0; k < CONE_SEGMENTS; k++) {
-        real a = 2 * 3.14159265358979323846 * k / CONE_SEGMENTS;
-        vec radial = add(scale(cos(a), u), scale(sin(a), v));
-        add_vertex(s, comb(rb, radial, base));
-        add_vertex(s, comb(ra, radial, apex));
-        add_normal(s, unit(comb((rb - ra) / len, ax, radial)));
-    }
-    for (k = 0; k < CONE_SEGMENTS; k++) {
-        int k1 = (k + 1) % CONE_SEGMENTS;
-        int b0 = first + 2 * k, a0 = b0 + 1, b1 = first + 2 * k1, a1 = b1 + 1;
-        if (rb > 0) add_triangle(s, b0, b1, a1, nfirst + k, nfirst + k1, nfirst + k1, mat);
-        if (ra > 0) add_triangle(s, b0, a1, a0, nfirst + k, nfirst + k1, nfirst + k, mat);
-    }
+    Cone *c;
+    s->cone = grow(s->cone, &s->capcone, s->ncone + 1, sizeof *s->cone);
+    c = &s->cone[s->ncone++];
+    c->base = base;
+    c->len = sqrt(dot(sub(apex, base), sub(apex, base)));
+    c->axis = unit(sub(apex, base));
+    c->rb = rb;
+    c->ra = ra;
+    c->mat = mat;
+}
+
+/* bx by bz rb  ax ay az ra: a cone's base and apex, each with its radius. */
+static int check_cone(Scene *s, Where w, const real *x, int mat)
+{
+    vec base = v3(x[0], x[1], x[2]), apex = v3(x[4], x[5], x[6]);
+    if (!(x[3] >= 0 && x[7] >= 0 && x[3] + x[7] > 0)) return fail(w, "cone radii must be >= 0 and not both 0", NULL);
+    if (!(dot(sub(apex, base), sub(apex, base)) > 0)) return fail(w, "cone base and apex coincide", NULL);
+    add_cone(s, base, x[3], apex, x[7], mat);
+    return 1;
 }
 
 /* r g b kd ks kt kl ir: minray's material fields, for tri and mesh lines. */
@@ -1079,6 +1158,10 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
         add_triangle(s, a, b, add_vertex(s, v3(v[6], v[7], v[8])), -1, -1, -1, mat);
         return 1;
     }
+    if (!strcmp(k, "cone")) {
+        if (!numbers(w, k, tok, ntok, 1, 16, v) || !material8(s, w, v + 8, &mat)) return 0;
+        return check_cone(s, w, v, mat);
+    }
     if (!strcmp(k, "mesh")) {
         char *path;
         if (ntok < 2) return fail(w, "mesh needs a file name and 8 numbers", NULL);
@@ -1249,14 +1332,7 @@ static int nff_sphere(Scene *s, Lexer *lx, int mat)
 static int nff_cone(Scene *s, Lexer *lx, int mat)
 {
     real x[8];
-    vec base, apex;
-    if (!nff_numbers(lx, "c", 8, x)) return 0;
-    base = v3(x[0], x[1], x[2]);
-    apex = v3(x[4], x[5], x[6]);
-    if (!(x[3] >= 0 && x[7] >= 0 && x[3] + x[7] > 0)) return fail(lx->w, "cone radii must be >= 0 and not both 0", NULL);
-    if (!(dot(sub(apex, base), sub(apex, base)) > 0)) return fail(lx->w, "cone base and apex coincide", NULL);
-    add_cone(s, base, x[3], apex, x[7], mat);
-    return 1;
+    return nff_numbers(lx, "c", 8, x) && check_cone(s, lx->w, x, mat);
 }
 
 static int load_nff(Scene *s, FILE *f, Where w)
@@ -1395,8 +1471,8 @@ static int build_tree(Scene *s, const char *accel)
 static void print_stats(const Scene *s, const Stats *st, int spp, double load, double seconds)
 {
     unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted;
-    fprintf(stderr, "scene      %d spheres, %d triangles, %d lights; read in %.3f s\n",
-            s->nsph, s->ntri, s->nlight, load);
+    fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d lights; read in %.3f s\n",
+            s->nsph, s->ncone, s->ntri, s->nlight, load);
     fprintf(stderr, "image      %dx%d, %d spp, depth %d\n", s->w, s->h, spp, s->depth);
     if (s->tree) {
         kd_info k;
@@ -1479,6 +1555,6 @@ int main(int argc, char **argv)
     free(img);
     free(auto_out);
     if (s.tree) kd_free(s.tree);
-    free(s.mat); free(s.sph); free(s.tri); free(s.vert); free(s.norm); free(s.light);
+    free(s.mat); free(s.sph); free(s.cone); free(s.tri); free(s.vert); free(s.norm); free(s.light);
     return ok ? 0 : 1;
 }

@@ -157,7 +157,7 @@ static int tri(Scene *s, vec a, vec b, vec c)
 static void free_scene(Scene *s)
 {
     if (s->tree) kd_free(s->tree);
-    free(s->mat); free(s->sph); free(s->tri); free(s->vert); free(s->norm); free(s->light);
+    free(s->mat); free(s->sph); free(s->cone); free(s->tri); free(s->vert); free(s->norm); free(s->light);
 }
 
 /* Legs from 1e-8 to 1e8, the ray starting one leg above: t must be one leg.
@@ -314,7 +314,9 @@ static void test_tree_matches_loop(void)
         vec c = v3(6 * rnd(&x) - 3, 6 * rnd(&x) - 3, 6 * rnd(&x) - 3);
         add_sphere(&s, c, 0.05 + 0.3 * rnd(&x), 0);
         tri(&s, c, add(c, v3(rnd(&x), rnd(&x), 0)), add(c, v3(0, rnd(&x), rnd(&x))));
+        add_cone(&s, c, 0.3 * rnd(&x), add(c, v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x))), 0.2 * rnd(&x), 0);
     }
+    add_cone(&s, v3(0, 0, -2), 0.5, v3(0, 0, 2), 0.5, 0);      /* along z: axis-parallel rays */
     tri(&s, v3(-4, -4, -1), v3(4, -4, -1), v3(-4, 4, -1));     /* axis-aligned: splits land on it */
     tri(&s, v3(0, 0, 0), v3(0, 2, 0), v3(0, 0, 2));
     build_tree(&s, "kd");
@@ -337,7 +339,7 @@ static void test_tree_matches_loop(void)
         s.tree = tree;
         if (ha != hb || (ha && (a.obj != b.obj || a.t != b.t))) wrong++;
     }
-    report(wrong == 0, "kd-tree = loop: same object and t for 1e6 rays (axis-parallel, in planes, inside)",
+    report(wrong == 0, "kd-tree = loop (spheres, cones, triangles): same object and t, 1e6 rays (axis-parallel, in planes, inside)",
            "%g mismatches of %g", wrong, n);
     free_scene(&s);
 }
@@ -412,9 +414,8 @@ static void test_nff_view(void)
            && near(s.ambient.x, sqrt(2) / 4, 1e-15),
            "NFF lights: optional colour, strength sqrt(L)/2L", "light %.15g ambient %.15g",
            s.light[1].color.x, s.ambient.x);
-    report(ok && s.nsph == 1 && s.ntri == 2 + 2 * CONE_SEGMENTS - CONE_SEGMENTS && s.tri[1].n[0] >= 0,
-           "NFF p, pp (with normals), s and c (a cone: 32 triangles)", "triangles %g, spheres %g",
-           s.ntri, s.nsph);
+    report(ok && s.nsph == 1 && s.ncone == 1 && s.ntri == 2 && s.tri[1].n[0] >= 0,
+           "NFF p, pp (with normals), s and c", "triangles %g, spheres %g", s.ntri, s.nsph);
     free_scene(&s);
 }
 
@@ -434,6 +435,29 @@ static void test_obj(void)
            "OBJ: a quad with normals, negative indices, a mesh line", "triangles %g, vertices %g",
            s.ntri, s.nvert);
     free_scene(&s);
+}
+
+/* Open cones and cylinders against answers worked out by hand. */
+static void test_cones(void)
+{
+    Cone cyl, cone;
+    vec n;
+    double t1, t2, t3, t4, t5, t6;
+    cyl.base = v3(0, 0, 0); cyl.axis = v3(0, 0, 1); cyl.len = 2; cyl.rb = cyl.ra = 1;
+    cone = cyl; cone.len = 1; cone.ra = 0;                       /* apex at z = 1 */
+    t1 = hit_cone(&cyl, ray(v3(5, 0, 1), v3(-1, 0, 0)), 0);      /* from outside: 4 */
+    t2 = hit_cone(&cyl, ray(v3(0, 0, 1), v3(0, 1, 0)), 0);       /* from inside: 1 */
+    t3 = hit_cone(&cyl, ray(v3(5, 0, 3), v3(-1, 0, 0)), 0);      /* above its end: miss */
+    t4 = hit_cone(&cyl, ray(v3(0.5, 0, -1), v3(0, 0, 1)), 0);    /* along the axis, open ends: miss */
+    t5 = hit_cone(&cone, ray(v3(5, 0, 0.5), v3(-1, 0, 0)), 0);   /* radius 0.5 there: 4.5 */
+    t6 = hit_cone(&cone, ray(v3(3, 0, 1.5), v3(-1, 0, 0)), 0);   /* beyond the apex: miss */
+    report(t1 == 4 && t2 == 1 && isinf(t3) && isinf(t4), "cylinder: outside, inside, past the end, along the axis",
+           "t = %g and %g", t1, t2);
+    report(near(t5, 4.5, 1e-15) && isinf(t6), "cone: the radius shrinks to the apex, and stops there",
+           "t = %.17g, beyond the apex %g", t5, t6);
+    n = cone_normal(&cone, v3(0.5, 0, 0.5));
+    report(near(n.x, sqrt(0.5), 1e-15) && near(n.z, sqrt(0.5), 1e-15) && n.y == 0,
+           "cone normal tilts with the slope", "n = (%.17g, ., %.17g)", n.x, n.z);
 }
 
 static void test_camera(void)
@@ -530,6 +554,7 @@ int main(void)
     test_triangle_scales();
     test_triangle_degenerate();
     test_triangle_culling();
+    test_cones();
     test_ear_clipping();
     test_nff_view();
     test_obj();
