@@ -122,6 +122,7 @@ typedef struct { vec pos, color; int sphere; } Light;
 typedef struct {
     vec eye, right, up, fwd;  /* orthonormal frame */
     real fov;                 /* horizontal, edge to edge, in degrees */
+    real tan_half;            /* tan(fov / 2), kept to spare a tan per ray */
     real anchor;              /* 0.5: samples centred on the pixel; 0: on its corner */
 } Camera;
 
@@ -659,7 +660,7 @@ static vec trace(const Scene *s, Ray r, int depth, Stats *st)
  * image's width spans the field of view edge to edge; a pixel is one unit. */
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
 {
-    real dist = (real)w / 2 / tan(c->fov * 3.14159265358979323846 / 360);
+    real dist = (real)w / 2 / c->tan_half;
     Ray r;
     r.o = c->eye;
     r.d = unit(add(add(scale(x - (real)w / 2, c->right),
@@ -988,6 +989,7 @@ static int set_camera(Scene *s, Where w, const real *v)
     c->fov = v[9];
     if (!(dot(sub(at, c->eye), sub(at, c->eye)) > 0)) return fail(w, "camera looks at its own eye", NULL);
     if (!(c->fov > 0 && c->fov < 180)) return fail(w, "field of view must be between 0 and 180 degrees", NULL);
+    c->tan_half = tan(c->fov * 3.14159265358979323846 / 360);
     c->fwd = unit(sub(at, c->eye));
     c->right = cross(c->fwd, up);
     if (!(dot(c->right, c->right) > 0)) return fail(w, "camera up is parallel to its view", NULL);

@@ -465,8 +465,9 @@ static void test_camera(void)
     Scene s;
     Ray c, e;
     double angle;
+    real v[10] = { 0, 0, 0, 0, 1, 0, 0, 0, 1, 60 };
     default_scene(&s);
-    s.cam.fov = 60;
+    set_camera(&s, (Where){ "", 0 }, v);
     c = camera_ray(&s.cam, 640, 480, 320, 240);
     e = camera_ray(&s.cam, 640, 480, 0, 240);
     angle = acos(dot(c.d, e.d)) * 180 / PI;
