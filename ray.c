@@ -41,7 +41,13 @@
  * is the same bytes for any number of threads, because no pixel depends on
  * another or on the order pixels are computed in.
  */
-#define _POSIX_C_SOURCE 200809L /* isatty, clock_gettime */
+/* Unix gets a progress line when stderr is a terminal, a wall clock for
+ * --stats, and care not to rename over a device given as -o; elsewhere the
+ * program is plain C99 and does without. */
+#if defined(__unix__) || defined(__APPLE__)
+#define _POSIX_C_SOURCE 200809L
+#define RAY_POSIX
+#endif
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -49,7 +55,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifdef RAY_POSIX
+#include <sys/stat.h>
 #include <unistd.h>
+#endif
 #include "kdtree.h"
 #ifdef _OPENMP
 #include <omp.h>
@@ -168,7 +177,10 @@ typedef struct {
 
 /* What --stats counts; each thread keeps its own and they are summed. */
 typedef struct {
-    unsigned long long primary, shadow, reflected, refracted, hits, tests, steps, queries;
+    unsigned long long primary, shadow, reflected, refracted;
+    unsigned long long queries, nearest, hits;  /* all tree or loop queries; nearest-hit ones; their hits */
+    unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
+    int threads;
 } Stats;
 
 /* ----------------------------------------------------- sphere intersection */
@@ -511,6 +523,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
     real t = INFINITY, ti;
     int i, best = -1;
     st->queries++;
+    st->nearest++;
     if (s->tree) {
         double o[3], d[3], tmax = INFINITY;
         kd_counters c = { 0, 0, 0 };
@@ -708,11 +721,26 @@ static unsigned char to_byte(real v)
 
 typedef struct { int spp, threads, progress; } Options;
 
+/* Seconds on a wall clock (processor time where there is none: with threads
+ * that overstates the time). */
 static double now(void)
 {
+#ifdef RAY_POSIX
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return ts.tv_sec + ts.tv_nsec * 1e-9;
+#else
+    return (double)clock() / CLOCKS_PER_SEC;
+#endif
+}
+
+static int stderr_is_terminal(void)
+{
+#ifdef RAY_POSIX
+    return isatty(2);
+#else
+    return 0;
+#endif
 }
 
 static void add_stats(Stats *to, const Stats *from)
@@ -725,6 +753,8 @@ static void add_stats(Stats *to, const Stats *from)
     to->tests += from->tests;
     to->steps += from->steps;
     to->queries += from->queries;
+    to->nearest += from->nearest;
+    if (from->threads > to->threads) to->threads = from->threads;
 }
 
 /* Rows go to threads one at a time, as they free up; each pixel is written
@@ -740,6 +770,10 @@ static void render(const Scene *s, const Options *o, unsigned char *img, Stats *
         Stats st;
         int j;
         memset(&st, 0, sizeof st);
+        st.threads = 1;
+#ifdef _OPENMP
+        st.threads = omp_get_num_threads();
+#endif
         OMP(omp for schedule(dynamic, 1))
         for (j = 0; j < s->h; j++) {
             int i, mine;
@@ -1386,30 +1420,70 @@ static int load_scene(Scene *s, const char *file)
 
 /* ------------------------------------------------------------------ output */
 
-/* The image goes to FILE.tmp and is renamed at the end, so that a failure
- * never leaves a half-written FILE behind. */
-static int write_ppm(const char *file, const unsigned char *img, int w, int h, int plain)
+/* Where the image goes.  It is opened before the render, so that a bad -o
+ * fails at once rather than after a long render.  A new or plain file is
+ * written as FILE.tmp and renamed over FILE at the end, so that a failure
+ * never leaves a half-written image behind.  Anything else (stdout, a device
+ * such as /dev/null, a pipe, a symbolic link) is written in place and never
+ * renamed over or removed. */
+typedef struct { FILE *f; const char *name; char *tmp; } Output;
+
+#ifdef RAY_POSIX
+/* Absent, or a plain file (not a link, a device or a pipe)? */
+static int replaceable(const char *name)
 {
-    char tmp[4096];
-    FILE *f;
-    int ok;
+    struct stat st;
+    return lstat(name, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode);
+}
+#else
+static int replaceable(const char *name) { (void)name; return 1; }
+#endif
+
+static int open_output(Output *o, const char *name)
+{
+    o->name = name;
+    o->tmp = NULL;
+    o->f = stdout;
+    if (!strcmp(name, "-")) return 1;
+    if (replaceable(name)) {
+        o->tmp = malloc(strlen(name) + 5);
+        if (!o->tmp) return 0;
+        sprintf(o->tmp, "%s.tmp", name);
+        errno = EEXIST;               /* the message if FILE.tmp is no plain file */
+        o->f = replaceable(o->tmp) ? fopen(o->tmp, "wb") : NULL;
+    } else
+        o->f = fopen(name, "wb");
+    if (o->f) return 1;
+    fprintf(stderr, "%s: cannot write: %s\n", o->tmp ? o->tmp : name, strerror(errno));
+    free(o->tmp);
+    return 0;
+}
+
+/* Gives up an output: nothing is left of it. */
+static void discard_output(Output *o)
+{
+    if (o->f != stdout) fclose(o->f);
+    if (o->tmp) remove(o->tmp);
+    free(o->tmp);
+}
+
+static int write_ppm(Output *o, const unsigned char *img, int w, int h, int plain)
+{
     size_t i, n = (size_t)w * h * 3;
-    if (!strcmp(file, "-")) f = stdout;
-    else {
-        if (strlen(file) + 5 > sizeof tmp) { fprintf(stderr, "%s: name too long\n", file); return 0; }
-        sprintf(tmp, "%s.tmp", file);
-        if (!(f = fopen(tmp, "wb"))) { fprintf(stderr, "%s: cannot write: %s\n", tmp, strerror(errno)); return 0; }
-    }
-    fprintf(f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
+    int ok;
+    fprintf(o->f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
     if (plain)
-        for (i = 0; i < n; i += 3) fprintf(f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
+        for (i = 0; i < n; i += 3) fprintf(o->f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
     else
-        fwrite(img, 1, n, f);
-    ok = !ferror(f);
-    if (f == stdout) return fflush(f) == 0 && ok;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, file) != 0) ok = 0;
-    if (!ok) { fprintf(stderr, "%s: cannot write: %s\n", file, strerror(errno)); remove(tmp); }
+        fwrite(img, 1, n, o->f);
+    ok = fflush(o->f) == 0 && !ferror(o->f);
+    if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
+    if (ok && o->tmp) ok = rename(o->tmp, o->name) == 0;
+    if (!ok) {
+        fprintf(stderr, "%s: cannot write: %s\n", o->name, strerror(errno));
+        if (o->tmp) remove(o->tmp);
+    }
+    free(o->tmp);
     return ok;
 }
 
@@ -1470,29 +1544,54 @@ static int build_tree(Scene *s, const char *accel)
     return 1;
 }
 
-static void print_stats(const Scene *s, const Stats *st, int spp, double load, double seconds)
+static void print_stats(const Scene *s, const Stats *st, int spp, double load, double build,
+                        double seconds)
 {
     unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted;
     fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d lights; read in %.3f s\n",
             s->nsph, s->ncone, s->ntri, s->nlight, load);
-    fprintf(stderr, "image      %dx%d, %d spp, depth %d\n", s->w, s->h, spp, s->depth);
+    fprintf(stderr, "image      %dx%d, %d spp, depth %d, %d thread%s\n", s->w, s->h, spp, s->depth,
+            st->threads, st->threads == 1 ? "" : "s");
     if (s->tree) {
         kd_info k;
         kd_describe(s->tree, &k);
         fprintf(stderr, "kd-tree    %ld nodes, %ld leaves (%ld empty), depth %ld, %.2f objects per leaf,\n"
                 "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
                 k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf,
-                k.bytes / 1e6, k.sah_cost, k.build_seconds);
+                k.bytes / 1e6, k.sah_cost, build);
     } else
         fprintf(stderr, "kd-tree    none: every ray tests every object\n");
     fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
             rays, st->primary, st->shadow, st->reflected, st->refracted);
-    fprintf(stderr, "hits       %llu (%.1f%% of nearest-hit rays)\n", st->hits,
-            rays ? 100.0 * st->hits / (double)st->queries : 0.0);
+    fprintf(stderr, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
+            st->nearest ? 100.0 * st->hits / (double)st->nearest : 0.0);
     fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
             st->queries ? (double)st->tests / st->queries : 0.0,
             st->queries ? (double)st->steps / st->queries : 0.0);
     fprintf(stderr, "time       %.3f s, %.2f Mrays/s\n", seconds, seconds > 0 ? rays / seconds * 1e-6 : 0.0);
+}
+
+static void free_scene(Scene *s)
+{
+    if (s->tree) kd_free(s->tree);
+    free(s->mat); free(s->sph); free(s->cone); free(s->tri);
+    free(s->vert); free(s->norm); free(s->light);
+}
+
+/* -s WxH onto the scene; 0 with a message when it is not such a size. */
+static int set_size(Scene *s, const char *size)
+{
+    char *x, *end = NULL;
+    long fw = strtol(size, &x, 10), fh = *x == 'x' ? strtol(x + 1, &end, 10) : 0;
+    if (x == size || *x != 'x' || end == x + 1 || *end) {
+        fprintf(stderr, "ray: -s needs WxH, like 640x480, not %s\n", size);
+        return 0;
+    }
+    if (!check_size((double)fw, (double)fh, &s->w, &s->h)) {
+        fprintf(stderr, "ray: -s %s: " SIZE_RULE "\n", size);
+        return 0;
+    }
+    return 1;
 }
 
 int main(int argc, char **argv)
@@ -1500,16 +1599,17 @@ int main(int argc, char **argv)
     Scene s;
     Options o = { 1, 0, 0 };
     Stats st;
-    const char *scene = NULL, *size = NULL, *accel = "auto";
-    char *out = NULL, *auto_out = NULL;
+    Output out;
+    const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
+    char *auto_name = NULL;
     int i, depth = 0, plain = 0, stats = 0, ok;
     unsigned char *img;
-    double t0, load;
+    double t0, load, build;
 
     for (i = 1; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
-        else if (!strcmp(a, "-o") && next) out = argv[++i];
+        else if (!strcmp(a, "-o") && next) name = argv[++i];
         else if (!strcmp(a, "-s") && next) size = argv[++i];
         else if (!strcmp(a, "-n")) { o.spp = int_arg(a, next, 1 << 20); i++; }
         else if (!strcmp(a, "-d")) { depth = int_arg(a, next, 64); i++; }
@@ -1527,36 +1627,32 @@ int main(int argc, char **argv)
     }
     if (!scene) { usage(stderr); return 2; }
     load = now();
-    if (!load_scene(&s, scene)) return 1;
-    if (size) {
-        char *x, *end = NULL;
-        long fw = strtol(size, &x, 10), fh = *x == 'x' ? strtol(x + 1, &end, 10) : 0;
-        if (x == size || *x != 'x' || end == x + 1 || *end) {
-            fprintf(stderr, "ray: -s needs WxH, like 640x480, not %s\n", size);
-            return 2;
-        }
-        if (!check_size((double)fw, (double)fh, &s.w, &s.h)) {
-            fprintf(stderr, "ray: -s %s: " SIZE_RULE "\n", size);
-            return 2;
-        }
-    }
-    if (depth) s.depth = depth;
-    if (!build_tree(&s, accel)) return 1;
+    ok = load_scene(&s, scene) && (!size || set_size(&s, size));
     load = now() - load;
-    if (!out) out = auto_out = default_output(scene);
-    o.progress = isatty(2);
+    if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
+    if (depth) s.depth = depth;
+    build = now();
+    ok = ok && build_tree(&s, accel);
+    build = now() - build;
+    if (ok && !name) name = auto_name = default_output(scene);
+    if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
 
     img = malloc((size_t)s.w * s.h * 3);
-    if (!img) { fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h); return 1; }
+    if (!img) {
+        fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h);
+        discard_output(&out);
+        free_scene(&s); free(auto_name);
+        return 1;
+    }
+    o.progress = stderr_is_terminal();
     memset(&st, 0, sizeof st);
     t0 = now();
     render(&s, &o, img, &st);
     t0 = now() - t0;
-    ok = write_ppm(out, img, s.w, s.h, plain);
-    if (stats) print_stats(&s, &st, o.spp, load, t0);
+    ok = write_ppm(&out, img, s.w, s.h, plain);
+    if (stats) print_stats(&s, &st, o.spp, load, build, t0);
     free(img);
-    free(auto_out);
-    if (s.tree) kd_free(s.tree);
-    free(s.mat); free(s.sph); free(s.cone); free(s.tri); free(s.vert); free(s.norm); free(s.light);
+    free(auto_name);
+    free_scene(&s);
     return ok ? 0 : 1;
 }

@@ -6,5 +6,5 @@ bad() { echo "FAIL $*"; }
 check() { local name=$1; shift; if "$@" >/dev/null 2>&1; then ok "$name"; else bad "$name"; fi; }
 CC=${CC:-cc}
 CFLAGS=${CFLAGS:--O2}
-TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
+export TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT

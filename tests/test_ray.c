@@ -154,11 +154,6 @@ static int tri(Scene *s, vec a, vec b, vec c)
     return s->ntri - 1;
 }
 
-static void free_scene(Scene *s)
-{
-    if (s->tree) kd_free(s->tree);
-    free(s->mat); free(s->sph); free(s->cone); free(s->tri); free(s->vert); free(s->norm); free(s->light);
-}
 
 /* Legs from 1e-8 to 1e8, the ray starting one leg above: t must be one leg.
  * The original epsilon (|det| < 1e-6) loses every leg below 1e-3. */
@@ -529,7 +524,7 @@ static int acne_at_scale(double k, int *counted)
             ++*counted;
             wrong += lit != truth;
         }
-    free(s.mat); free(s.sph); free(s.light);
+    free_scene(&s);
     return wrong;
 }
 
