@@ -73,6 +73,7 @@
 typedef REAL real;
 /* The unit roundoff of `real`, for error bounds that follow the build. */
 #define REAL_EPS (sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON)
+#define PI 3.14159265358979323846
 
 /* ---------------------------------------------------------------- vectors */
 
@@ -219,12 +220,17 @@ static real hit_sphere(const Sphere *s, Ray r, real tmin)
  * A point at height h = (p - base).axis lies on the side when its distance
  * from the axis is the radius there, rb + k h, with k the slope (ra - rb)/len,
  * and 0 <= h <= len.  Squaring gives a quadratic A t^2 + 2B t + C = 0 in the
- * ray's t; both roots come out without cancellation as for the sphere (q and
- * C/q), and each is kept only if its height lies on the cone.  A cylinder is
- * the case k = 0. */
+ * ray's t, and each root is kept only if its height lies on the cone.  A
+ * cylinder is the case k = 0.
+ * Precision: B^2 - AC cancels when the ray starts far from the cone (its
+ * terms grow with the distance squared).  So the ray is first moved along
+ * itself to t0, level with the cone's middle, the quadratic solved from
+ * there, and t0 added back: the same idea as the sphere's closest point.
+ * The roots then come from q and C/q, so that neither subtracts. */
 static real hit_cone(const Cone *c, Ray r, real tmin)
 {
-    vec q = sub(r.o, c->base);
+    real t0 = dot(sub(comb(c->len / 2, c->axis, c->base), r.o), r.d) / dot(r.d, r.d);
+    vec q = sub(comb(t0, r.d, r.o), c->base);
     real k = (c->ra - c->rb) / c->len;
     real qh = dot(q, c->axis), dh = dot(r.d, c->axis);
     vec qx = comb(-qh, c->axis, q), dx = comb(-dh, c->axis, r.d); /* across the axis */
@@ -246,7 +252,7 @@ static real hit_cone(const Cone *c, Ray r, real tmin)
     }
     for (i = 0; i < 2; i++) {
         real h = qh + root[i] * dh;
-        if (root[i] > tmin && h >= 0 && h <= c->len) return root[i];
+        if (root[i] + t0 > tmin && h >= 0 && h <= c->len) return root[i] + t0;
     }
     return INFINITY;
 }
@@ -1023,7 +1029,7 @@ static int set_camera(Scene *s, Where w, const real *v)
     c->fov = v[9];
     if (!(dot(sub(at, c->eye), sub(at, c->eye)) > 0)) return fail(w, "camera looks at its own eye", NULL);
     if (!(c->fov > 0 && c->fov < 180)) return fail(w, "field of view must be between 0 and 180 degrees", NULL);
-    c->tan_half = tan(c->fov * 3.14159265358979323846 / 360);
+    c->tan_half = tan(c->fov * PI / 360);
     c->fwd = unit(sub(at, c->eye));
     c->right = cross(c->fwd, up);
     if (!(dot(c->right, c->right) > 0)) return fail(w, "camera up is parallel to its view", NULL);
@@ -1240,24 +1246,27 @@ static int load_sph(Scene *s, FILE *f, Where w)
 /* -------- NFF, Eric Haines' Neutral File Format (the SPD scenes' format) */
 
 /* NFF is a stream of blank-separated tokens, not of lines (a cone's eight
- * numbers may sit on one line or three), so it is read a token at a time. */
-typedef struct { FILE *f; Where w; int c; char tok[64]; } Lexer;
+ * numbers may sit on one line or three), so it is read a token at a time.
+ * `again` hands the last token out once more, for a look ahead. */
+typedef struct { FILE *f; Where w; int c, again; char tok[256]; } Lexer;
 
-/* The next token into lx->tok; 0 at the end of the file. */
+static int blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+/* The next token into lx->tok: 1, or 0 at the end of the file, or -1 after
+ * saying what is wrong. */
 static int next_token(Lexer *lx)
 {
     int n = 0;
+    if (lx->again) { lx->again = 0; return 1; }
     for (;;) {
-        while (lx->c == ' ' || lx->c == '\t' || lx->c == '\r' || lx->c == '\n') {
+        for (; blank(lx->c); lx->c = getc(lx->f))
             if (lx->c == '\n') lx->w.line++;
-            lx->c = getc(lx->f);
-        }
         if (lx->c != '#') break;
         while (lx->c != '\n' && lx->c != EOF) lx->c = getc(lx->f);
     }
-    while (lx->c != EOF && lx->c != ' ' && lx->c != '\t' && lx->c != '\r' && lx->c != '\n') {
-        if (n < (int)sizeof lx->tok - 1) lx->tok[n++] = (char)lx->c;
-        lx->c = getc(lx->f);
+    for (; lx->c != EOF && !blank(lx->c); lx->c = getc(lx->f)) {
+        if (n == (int)sizeof lx->tok - 1) return fail(lx->w, "token longer than 255 characters", NULL) - 1;
+        lx->tok[n++] = (char)lx->c;
     }
     lx->tok[n] = 0;
     return n > 0;
@@ -1268,35 +1277,35 @@ static int nff_numbers(Lexer *lx, const char *what, int n, real *out)
 {
     int i;
     for (i = 0; i < n; i++) {
-        if (!next_token(lx)) return fail(lx->w, "the file ends inside", what);
-        if (!number(lx->w, lx->tok, &out[i])) return 0;
+        int got = next_token(lx);
+        if (got == 0) return fail(lx->w, "the file ends inside", what);
+        if (got < 0 || !number(lx->w, lx->tok, &out[i])) return 0;
     }
     return 1;
 }
 
-/* The view block: from, at, up, angle, hither, resolution.  NFF's angle
- * spans the centres of the outer pixels, (W-1) pixels, where ours spans the
- * edges, W pixels. */
+/* The view block: from, at, up, angle, hither, resolution, each once.  NFF's
+ * angle spans the centres of the outer pixels, (W-1) pixels, where ours
+ * spans the edges, W pixels. */
 static int nff_view(Scene *s, Lexer *lx)
 {
-    real v[10], x[3], angle = 45, res[2] = { 512, 512 };
-    int seen = 0;
-    const char *names[] = { "from", "at", "up", "angle", "hither", "resolution" };
-    int counts[] = { 3, 3, 3, 1, 1, 2 }, k;
-    while (seen < 6 && next_token(lx)) {
+    static const char *const names[6] = { "from", "at", "up", "angle", "hither", "resolution" };
+    static const int counts[6] = { 3, 3, 3, 1, 1, 2 };
+    real x[6][3], v[10];
+    int seen = 0, k, got = 1;
+    while (seen != 63 && (got = next_token(lx)) > 0) {
         for (k = 0; k < 6 && strcmp(lx->tok, names[k]); k++) continue;
         if (k == 6) return fail(lx->w, "expected from, at, up, angle, hither or resolution", lx->tok);
-        if (!nff_numbers(lx, names[k], counts[k], x)) return 0;
-        if (k < 3) { v[3 * k] = x[0]; v[3 * k + 1] = x[1]; v[3 * k + 2] = x[2]; }
-        if (k == 3) angle = x[0];
-        if (k == 5 && !check_size(x[0], x[1], &s->w, &s->h)) return fail(lx->w, SIZE_RULE, NULL);
-        if (k == 5) { res[0] = x[0]; res[1] = x[1]; }
-        seen++;
+        if (seen & 1 << k) return fail(lx->w, "said twice in the view block", names[k]);
+        seen |= 1 << k;
+        if (!nff_numbers(lx, names[k], counts[k], x[k])) return 0;
     }
-    if (seen < 6) return fail(lx->w, "the view block needs from, at, up, angle, hither and resolution", NULL);
-    if (!(angle > 0 && angle < 180)) return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
-    v[9] = atan(tan(angle * 3.14159265358979323846 / 360) * res[0] / (res[0] > 1 ? res[0] - 1 : 1))
-           * 360 / 3.14159265358979323846;          /* twice the half angle, in degrees */
+    if (got < 0) return 0;
+    if (seen != 63) return fail(lx->w, "the view block needs from, at, up, angle, hither and resolution", NULL);
+    if (!check_size(x[5][0], x[5][1], &s->w, &s->h)) return fail(lx->w, SIZE_RULE, NULL);
+    if (!(x[3][0] > 0 && x[3][0] < 180)) return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
+    for (k = 0; k < 9; k++) v[k] = x[k / 3][k % 3];   /* from, at, up */
+    v[9] = 2 * atan(tan(x[3][0] * PI / 360) * s->w / (s->w > 1 ? s->w - 1 : 1)) * 180 / PI;
     return set_camera(s, lx->w, v);
 }
 
@@ -1327,17 +1336,12 @@ static int nff_polygon(Scene *s, Lexer *lx, int normals, int mat)
 static int nff_light(Scene *s, Lexer *lx)
 {
     real x[3], rgb[3] = { 1, 1, 1 };
-    Lexer before;
-    long at;
+    int got;
     if (!nff_numbers(lx, "l", 3, x)) return 0;
-    before = *lx;                /* look at the next token, and put it back */
-    at = ftell(lx->f);           /* unless it is a number */
-    if (next_token(lx) && strchr("+-.0123456789", lx->tok[0])) {
-        if (!number(lx->w, lx->tok, &rgb[0]) || !nff_numbers(lx, "l", 2, rgb + 1)) return 0;
-    } else {
-        *lx = before;
-        fseek(lx->f, at, SEEK_SET);
-    }
+    got = next_token(lx);                    /* a colour, or the next entity */
+    if (got < 0) return 0;
+    lx->again = got > 0;
+    if (got > 0 && strchr("+-.0123456789", lx->tok[0]) && !nff_numbers(lx, "l", 3, rgb)) return 0;
     add_light(s, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]), -1);
     return 1;
 }
@@ -1375,10 +1379,10 @@ static int load_nff(Scene *s, FILE *f, Where w)
 {
     Lexer lx;
     real x[3];
-    int mat = -1, k, ok = 1;
+    int mat = -1, k, ok = 1, got = 1;
     double intensity;
-    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f);
-    while (ok && next_token(&lx)) {
+    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.again = 0;
+    while (ok && (got = next_token(&lx)) > 0) {
         const char *t = lx.tok;
         if (mat < 0 && strchr("spc", t[0])) {    /* objects before any f: plain white */
             Material m;
@@ -1395,6 +1399,7 @@ static int load_nff(Scene *s, FILE *f, Where w)
         else if (!strcmp(t, "pp")) ok = nff_polygon(s, &lx, 1, mat);
         else ok = fail(lx.w, "unknown NFF entity", t);
     }
+    ok = ok && got == 0;                         /* the end, not a bad token */
     /* The SPD's suggested strength: sqrt(L) / (2 L) for each of L lights and
      * for the ambient, so that the total stays about the same for any L. */
     intensity = s->nlight ? sqrt((double)s->nlight) / (2.0 * s->nlight) : 0;

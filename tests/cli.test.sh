@@ -99,3 +99,18 @@ printf 'camera 0 0 -3 0 0 0 0 1 0 40\nlight 0 0 -5 1 1 1\nmesh ok.obj 1 1 1 1 0 
 ./ray -s 8x8 -o "$TMP/out.ppm" "$TMP/m.sph" 2> "$TMP/err"; rc=$?
 [ $rc -eq 0 ] && [ "$(grep -c warning "$TMP/err")" = 1 ] && [ -s "$TMP/out.ppm" ] \
   && ok "OBJ: other statements get one warning, not a failure" || bad "OBJ warning: exit $rc, $(cat "$TMP/err")"
+
+# Output that is not a plain file is written in place, never renamed over.
+ln -s "$TMP/target.ppm" "$TMP/link.ppm"
+./ray -s 4x4 -o "$TMP/link.ppm" scenes/minray.sph
+[ -L "$TMP/link.ppm" ] && [ -s "$TMP/target.ppm" ] && ok "-o through a symbolic link keeps the link" \
+  || bad "-o replaced a symbolic link"
+mkfifo "$TMP/fifo"
+cat "$TMP/fifo" > "$TMP/from_fifo" &
+./ray -s 4x4 -o "$TMP/fifo" scenes/minray.sph; wait
+[ -p "$TMP/fifo" ] && [ "$(head -c 2 "$TMP/from_fifo")" = P6 ] && ok "-o into a pipe writes through it" \
+  || bad "-o into a pipe"
+# A bad -o fails before the render, not after it (this render would take minutes).
+start=$(date +%s)
+./ray -s 8000x8000 -n 64 -o "$TMP/no/such/dir/x.ppm" scenes/whitted.sph 2>/dev/null; rc=$?
+[ $rc -ne 0 ] && [ $(( $(date +%s) - start )) -lt 5 ] && ok "an unwritable -o fails at once" || bad "unwritable -o: exit $rc"

@@ -6,7 +6,6 @@
 #define main ray_main
 #include "../ray.c"
 #undef main
-#define PI 3.14159265358979323846
 
 static int failures;
 
@@ -450,6 +449,24 @@ static void test_cones(void)
            "t = %g and %g", t1, t2);
     report(near(t5, 4.5, 1e-15) && isinf(t6), "cone: the radius shrinks to the apex, and stops there",
            "t = %.17g, beyond the apex %g", t5, t6);
+    {   /* far away: a unit cylinder at 1e4 .. 1e8, aimed across it off centre */
+        double d, worst = 0;
+        for (d = 1e4; d <= 1e8; d *= 10) {
+            Cone far = cyl;
+            double t;
+            far.base = v3(0, d, 0);
+            t = hit_cone(&far, ray(v3(0, 0, 1), unit(v3(0.6, d, 0))), 0);
+            /* exact: the line x = 0.6 y / d meets x^2 + (y - d)^2 = 1 */
+            {
+                long double k = 0.6L / d, A = 1 + k * k, B = -2.0L * d, C = (long double)d * d - 1;
+                long double y = (-B - sqrtl(B * B - 4 * A * C)) / (2 * A);
+                long double te = sqrtl(y * y + (k * y) * (k * y));
+                if (!(fabs(t - (double)te) / d <= worst)) worst = fabs(t - (double)te) / d;
+            }
+        }
+        report(worst <= 1e-9, "cylinder far away (1e4..1e8): |t - t_exact| <= 1e-9 * distance",
+               "worst relative error %.3g, allowed %g", worst, 1e-9);
+    }
     n = cone_normal(&cone, v3(0.5, 0, 0.5));
     report(near(n.x, sqrt(0.5), 1e-15) && near(n.z, sqrt(0.5), 1e-15) && n.y == 0,
            "cone normal tilts with the slope", "n = (%.17g, ., %.17g)", n.x, n.z);
@@ -528,9 +545,67 @@ static int acne_at_scale(double k, int *counted)
     return wrong;
 }
 
+/* A cylinder (seen from the side, so its open ends stay hidden) or a
+ * triangle, alone with a light on the camera's side, everything times k and
+ * the camera `far` units away: no part of it can shadow another, so every
+ * point whose normal faces the light must be lit. */
+static int lone_acne(int cylinder, double k, double far, int *counted)
+{
+    Scene s;
+    Material m;
+    Stats st;
+    real v[10];
+    int i, j, wrong = 0, W = 64;
+    memset(&st, 0, sizeof st);
+    memset(&m, 0, sizeof m);
+    m.color = v3(1, 1, 1);
+    m.kd = m.ir = 1;
+    default_scene(&s);
+    add_material(&s, m);
+    if (cylinder) add_cone(&s, v3(0, 0, -k), k, v3(0, 0, k), k, 0);
+    else {
+        int a = add_vertex(&s, v3(-k, 0, -k)), b = add_vertex(&s, v3(k, 0.3 * k, -k));
+        add_triangle(&s, a, b, add_vertex(&s, v3(0, -0.2 * k, k)), -1, -1, -1, 0);
+    }
+    add_light(&s, v3(0.5 * far * k, -far * k, 0.3 * far * k), v3(1, 1, 1), -1);
+    v[0] = 0; v[1] = -far * k; v[2] = 0; v[3] = 0; v[4] = 0; v[5] = 0;
+    v[6] = 0; v[7] = 0; v[8] = 1; v[9] = 2 * atan(1.5 / far) * 180 / PI;
+    set_camera(&s, (Where){ "", 0 }, v);
+    *counted = 0;
+    for (j = 0; j < W; j++)
+        for (i = 0; i < W; i++) {
+            Hit h;
+            real e;
+            int lit;
+            if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &st)) continue;
+            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], &e, &st);
+            if (!(e > 1e-6)) continue;
+            ++*counted;
+            wrong += !lit;
+        }
+    free_scene(&s);
+    return wrong;
+}
+
 static void test_acne(void)
 {
-    double k;
+    double k, far;
+    int cyl;
+    for (cyl = 0; cyl < 2; cyl++)
+        for (far = 10; far <= 1e4; far *= 1000) {
+            int counted = 0, wrong = 0, c;
+            for (k = 1e-3; k <= 1e5 * 1.001; k *= 10) {
+                wrong += lone_acne(cyl, k, far, &c);
+                counted += c;
+            }
+            {
+                char name[96];
+                sprintf(name, "no acne on a lone %s, scales 1e-3..1e5, camera %g sizes away",
+                        cyl ? "cylinder" : "triangle", far);
+                report(wrong == 0 && counted > 9 * 500, name, "%g wrongly shadowed of %g lit-side pixels",
+                       wrong, counted);
+            }
+        }
     for (k = 1e-3; k <= 1e5 * 1.001; k *= 10) {
         int counted, wrong = acne_at_scale(k, &counted);
         char name[80];
