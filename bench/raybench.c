@@ -1,0 +1,590 @@
+/* raybench.c - the kd-tree's build and traversal, measured on ray.c's own code.
+ *
+ *     cc -O2 -o raybench bench/raybench.c kdtree.c -lm      (no -fopenmp: one thread)
+ *
+ *     raybench build [MAXN]          build time against N on cube-spheres of 10k
+ *                                    up to MAXN (default 1M) triangles, and the
+ *                                    fitted exponent
+ *     raybench rays MESH.obj RAYS.bin...
+ *                                    trace the rays of RAYHITS1 files (written by
+ *                                    ../shared/embree/embree_rays -out) and compare
+ *                                    our hits with Embree's
+ *     raybench made MESH.obj W H N [VIEW.nff]
+ *                                    W x H primary and N random rays made here by
+ *                                    the conventions of embree_rays.c's header
+ *                                    (bit for bit the same rays), for a machine
+ *                                    without Embree: timed, nothing to compare
+ *
+ * ray.c is included whole, as tests/test_ray.c does, so that what is timed is
+ * the renderer's real triangle test, clip callback and tree walk, not a copy
+ * that could drift from them.  Everything runs on one thread.  Tables go to
+ * standard output, each measurement followed by a line "result key=value ..."
+ * for bench/run.sh to read.
+ */
+#define main ray_main
+#include "../ray.c"
+#undef main
+#include <stdint.h>
+
+#define RB_PI 3.14159265358979323846
+#define RB_REPEAT 3 /* best of 3: the fastest run is the one least disturbed */
+
+/* A monotonic clock of our own: ray.c's now() is an internal of a file that
+ * is being edited, and the bench should not break when it is renamed. */
+static double rb_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void rb_die(const char *what, const char *arg)
+{
+    fprintf(stderr, "raybench: %s%s%s\n", what, arg ? ": " : "", arg ? arg : "");
+    exit(1);
+}
+
+/* ------------------------------------------------------------------ rays */
+
+/* One ray in Embree's float precision, with Embree's answer when known
+ * (prim -1: a miss; -2: no answer, the ray was made here). */
+typedef struct {
+    float o[3], d[3];
+    float t;
+    int32_t prim;
+} RbRay;
+
+/* RAYHITS1 stores little-endian 32-bit words; assembling them byte by byte
+ * reads the file the same on any host. */
+static uint32_t rb_u32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+static float rb_f32(const unsigned char *p)
+{
+    uint32_t u = rb_u32(p);
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+/* The header comment of embree_rays.c: "RAYHITS1", uint32 count, uint32
+ * record size 48, then per ray org[3] dir[3] tnear tfar t_hit primID u v. */
+static RbRay *rb_read_rayhits(const char *path, long *count)
+{
+    unsigned char head[16], rec[48];
+    uint32_t n, size, i;
+    RbRay *rays;
+    FILE *f = fopen(path, "rb");
+    if (!f) rb_die("cannot open", path);
+    if (fread(head, 1, 16, f) != 16 || memcmp(head, "RAYHITS1", 8)) rb_die("not a RAYHITS1 file", path);
+    n = rb_u32(head + 8);
+    size = rb_u32(head + 12);
+    if (size != 48 || n == 0 || n > 100000000u) rb_die("unexpected RAYHITS1 header", path);
+    rays = malloc((size_t)n * sizeof *rays);
+    if (!rays) rb_die("out of memory for the rays of", path);
+    for (i = 0; i < n; i++) {
+        int k;
+        if (fread(rec, 1, 48, f) != 48) rb_die("RAYHITS1 file ends early", path);
+        for (k = 0; k < 3; k++) {
+            rays[i].o[k] = rb_f32(rec + 4 * k);
+            rays[i].d[k] = rb_f32(rec + 12 + 4 * k);
+        }
+        /* tnear (rec + 24) is 0 and tfar_in (rec + 28) infinite in every
+         * file embree_rays writes: rays from the origin, unbounded. */
+        rays[i].t = rb_f32(rec + 32);
+        rays[i].prim = (int32_t)rb_u32(rec + 36);
+    }
+    fclose(f);
+    *count = (long)n;
+    return rays;
+}
+
+/* The mesh's box as embree_rays computes it (vertices read as floats), so
+ * that primary and random rays made here are the ones it would make. */
+typedef struct { double c[3], he[3], R; } RbBox;
+
+static RbBox rb_box(const Scene *s)
+{
+    float lo[3], hi[3];
+    RbBox b;
+    int i, k;
+    for (k = 0; k < 3; k++) lo[k] = FLT_MAX, hi[k] = -FLT_MAX;
+    for (i = 0; i < s->nvert; i++) {
+        float p[3];
+        p[0] = (float)s->vert[i].x; p[1] = (float)s->vert[i].y; p[2] = (float)s->vert[i].z;
+        for (k = 0; k < 3; k++) {
+            if (p[k] < lo[k]) lo[k] = p[k];
+            if (p[k] > hi[k]) hi[k] = p[k];
+        }
+    }
+    b.R = 0;
+    for (k = 0; k < 3; k++) {
+        b.c[k] = 0.5 * ((double)lo[k] + hi[k]);
+        b.he[k] = 0.5 * ((double)hi[k] - lo[k]);
+        b.R += b.he[k] * b.he[k];
+    }
+    b.R = sqrt(b.R);
+    return b;
+}
+
+static void rb_norm(double *a)
+{
+    double l = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    a[0] /= l; a[1] /= l; a[2] /= l;
+}
+
+static void rb_cross(const double *a, const double *b, double *c)
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* from, at, up and angle of an NFF view, the camera embree_rays' -nffview
+ * takes.  Returns 0 when one of them is missing. */
+static int rb_nff_view(const char *path, double eye[3], double at[3], double up[3], double *fov)
+{
+    char tok[256];
+    int got = 0;
+    FILE *f = fopen(path, "r");
+    if (!f) rb_die("cannot open", path);
+    while (got < 4 && fscanf(f, "%255s", tok) == 1) {
+        if (!strcmp(tok, "from")) got += fscanf(f, "%lf %lf %lf", &eye[0], &eye[1], &eye[2]) == 3;
+        else if (!strcmp(tok, "at")) got += fscanf(f, "%lf %lf %lf", &at[0], &at[1], &at[2]) == 3;
+        else if (!strcmp(tok, "up")) got += fscanf(f, "%lf %lf %lf", &up[0], &up[1], &up[2]) == 3;
+        else if (!strcmp(tok, "angle")) got += fscanf(f, "%lf", fov) == 1;
+    }
+    fclose(f);
+    return got == 4;
+}
+
+/* Primary rays by embree_rays' stated pinhole convention: without a view,
+ * looking down -z at the box centre from where the bounding sphere just
+ * fills the 45-degree vertical field of view; with one, the NFF camera. */
+static RbRay *rb_primary(const Scene *s, int w, int h, const char *view)
+{
+    RbBox b = rb_box(s);
+    double eye[3], at[3], up[3] = { 0, 1, 0 }, f[3], r[3], u[3], fov = 45, th;
+    RbRay *rays = malloc((size_t)w * h * sizeof *rays);
+    int x, y, k;
+    if (!rays) rb_die("out of memory for primary rays", NULL);
+    if (view) {
+        if (!rb_nff_view(view, eye, at, up, &fov)) rb_die("no from, at, up and angle in", view);
+    } else {
+        double dist = b.R / sin(0.5 * fov * RB_PI / 180);
+        for (k = 0; k < 3; k++) at[k] = b.c[k];
+        eye[0] = b.c[0]; eye[1] = b.c[1]; eye[2] = b.c[2] + dist;   /* dir (0, 0, -1) */
+    }
+    th = tan(0.5 * fov * RB_PI / 180);
+    for (k = 0; k < 3; k++) f[k] = at[k] - eye[k];
+    rb_norm(f);
+    rb_cross(f, up, r);
+    if (sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) < 1e-6) {  /* up along the view */
+        double up2[3] = { 0, 0, 1 };
+        if (fabs(f[2]) > 0.9) up2[1] = 1, up2[2] = 0;
+        rb_cross(f, up2, r);
+    }
+    rb_norm(r);
+    rb_cross(r, f, u);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            double sx = (2.0 * (x + 0.5) / w - 1) * th * ((double)w / h);
+            double sy = (1 - 2.0 * (y + 0.5) / h) * th, d[3];
+            RbRay *ry = &rays[(size_t)y * w + x];
+            for (k = 0; k < 3; k++) d[k] = f[k] + sx * r[k] + sy * u[k];
+            rb_norm(d);
+            for (k = 0; k < 3; k++) ry->o[k] = (float)eye[k], ry->d[k] = (float)d[k];
+            ry->t = 0;
+            ry->prim = -2;
+        }
+    return rays;
+}
+
+/* splitmix64 (Steele, Lea and Flood, "Fast splittable pseudorandom number
+ * generators", OOPSLA 2014): the stream embree_rays draws its random rays
+ * from, so that a seed names the same rays there and here. */
+static uint64_t rb_state;
+static double rb_uniform(void)
+{
+    uint64_t z = (rb_state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * (1.0 / 9007199254740992.0);   /* 53 bits in [0, 1) */
+}
+
+/* Origins uniform in the box grown 1.5 times about its centre, directions
+ * uniform on the sphere: incoherent rays, many starting inside the mesh. */
+static RbRay *rb_random(const Scene *s, long n, uint64_t seed)
+{
+    RbBox b = rb_box(s);
+    RbRay *rays = malloc((size_t)n * sizeof *rays);
+    long i;
+    int k;
+    if (!rays) rb_die("out of memory for random rays", NULL);
+    rb_state = seed;
+    for (i = 0; i < n; i++) {
+        double o[3], z, phi, sz;
+        for (k = 0; k < 3; k++) o[k] = b.c[k] + (2 * rb_uniform() - 1) * b.he[k] * 1.5;
+        z = 2 * rb_uniform() - 1;
+        phi = 2 * RB_PI * rb_uniform();
+        sz = sqrt(1 - z * z);
+        for (k = 0; k < 3; k++) rays[i].o[k] = (float)o[k];
+        rays[i].d[0] = (float)(sz * cos(phi));
+        rays[i].d[1] = (float)(sz * sin(phi));
+        rays[i].d[2] = (float)z;
+        rays[i].t = 0;
+        rays[i].prim = -2;
+    }
+    return rays;
+}
+
+/* ---------------------------------------------------------------- scenes */
+
+static int rb_white(Scene *s)
+{
+    Material m;
+    memset(&m, 0, sizeof m);
+    m.color = v3(1, 1, 1);
+    m.kd = 1;
+    m.ir = 1;
+    return add_material(s, m);
+}
+
+/* Only the arrays a mesh scene can fill are freed: the others stay NULL here,
+ * and naming each would tie the bench to every field of a Scene in flux. */
+static void rb_free_scene(Scene *s)
+{
+    if (s->tree) kd_free(s->tree);
+    free(s->mat); free(s->sph); free(s->tri); free(s->vert); free(s->norm); free(s->light);
+}
+
+static void rb_load_mesh(Scene *s, const char *path)
+{
+    Where w;
+    w.file = path;
+    w.line = 0;
+    default_scene(s);
+    if (!load_obj(s, path, rb_white(s), w)) exit(1);
+    if (s->ntri == 0) rb_die("no triangles in", path);
+}
+
+/* Builds the tree; returns the wall-clock seconds it took. */
+static double rb_build(Scene *s)
+{
+    double t0 = rb_now();
+    if (!build_tree(s, "kd") || !s->tree) rb_die("kd-tree build failed", NULL);
+    return rb_now() - t0;
+}
+
+/* What the tree costs in memory and shape, per triangle. */
+static void rb_tree_line(const Scene *s, double seconds)
+{
+    kd_info k;
+    kd_describe(s->tree, &k);
+    printf("kd-tree    %d objects, built in %.3f s: %ld nodes, depth %ld, %.2f refs/object, "
+           "%.1f bytes/object, SAH cost %.2f\n", nobj(s), seconds, k.nodes, k.max_depth,
+           (double)k.prim_refs / nobj(s), (double)k.bytes / nobj(s), k.sah_cost);
+    printf("result objects=%d build_s=%.4f nodes=%ld depth=%ld refs_per_obj=%.3f bytes_per_obj=%.2f sah=%.3f\n",
+           nobj(s), seconds, k.nodes, k.max_depth, (double)k.prim_refs / nobj(s),
+           (double)k.bytes / nobj(s), k.sah_cost);
+}
+
+/* ---------------------------------------------------------------- tracing */
+
+/* Traces every ray once, single-threaded; the object hit (-1: none) and its
+ * t go to obj and t.  bare = 0 asks nearest_hit(), what the renderer calls,
+ * which also computes the hit point and normals; bare = 1 asks the tree
+ * alone for the object and t, what rtcIntersect1 returns.  Returns seconds. */
+static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int *obj, double *t)
+{
+    Stats st;
+    double t0;
+    long i;
+    memset(&st, 0, sizeof st);
+    t0 = rb_now();
+    for (i = 0; i < n; i++) {
+        Ray r;
+        r.o = v3(rays[i].o[0], rays[i].o[1], rays[i].o[2]);
+        r.d = v3(rays[i].d[0], rays[i].d[1], rays[i].d[2]);
+        if (bare) {
+            double o[3], d[3], tmax = INFINITY;
+            o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
+            d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
+            obj[i] = kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, NULL);
+            t[i] = tmax;
+        } else {
+            Hit h;
+            if (nearest_hit(s, r, &h, &st)) obj[i] = h.obj, t[i] = h.t;
+            else obj[i] = -1, t[i] = INFINITY;
+        }
+    }
+    return rb_now() - t0;
+}
+
+static double rb_best(const Scene *s, const RbRay *rays, long n, int bare, int *obj, double *t)
+{
+    double best = HUGE_VAL;
+    int k;
+    for (k = 0; k < RB_REPEAT; k++) {
+        double secs = rb_trace(s, rays, n, bare, obj, t);
+        if (secs < best) best = secs;
+    }
+    return best;
+}
+
+/* Our hits against Embree's: the same triangle, and t within a relative
+ * 1e-4.  Embree traces in float, so rays through a shared edge or vertex,
+ * and grazing ones at the silhouette, may disagree by rounding alone, and a
+ * ray starting a hair from the surface gets a tiny t whose float rounding
+ * (about 1e-7 of the coordinates) exceeds 1e-4 of it.  The kinds are counted
+ * apart, and a t mismatch on the same triangle within 1e-6 of the box's
+ * half-diagonal (as embree_rays' own checker does) is called float rounding,
+ * so that a real bug stands out from such cases. */
+static void rb_compare(const Scene *s, const char *set, const RbRay *rays, long n, const int *obj, const double *t)
+{
+    long both_miss = 0, agree = 0, tie = 0, tfloat = 0, tdiff = 0, ours_only = 0, theirs_only = 0, i;
+    int first_tri = nobj(s) - s->ntri;  /* triangles come last, in file order */
+    double small = 1e-6 * rb_box(s).R;
+    for (i = 0; i < n; i++) {
+        /* -3: we hit something that is not a triangle, which Embree never can */
+        int ours = obj[i] >= first_tri ? obj[i] - first_tri : obj[i] < 0 ? -1 : -3;
+        int theirs = rays[i].prim;
+        double dt;
+        if (ours == -1 && theirs < 0) both_miss++;
+        else if (theirs < 0) ours_only++;
+        else if (ours == -1) theirs_only++;
+        else if ((dt = fabs(t[i] - (double)rays[i].t)) <= 1e-4 * fabs((double)rays[i].t))
+            ours == theirs ? agree++ : tie++;
+        else if (ours == theirs && dt <= small) tfloat++;
+        else tdiff++;
+    }
+    printf("vs Embree  %ld agree, %ld both miss; %ld disagree: %ld same t but another triangle "
+           "(a shared edge or vertex), %ld same triangle with t off by float rounding (tiny t), "
+           "%ld t differs, %ld hit by us only, %ld by Embree only\n", agree, both_miss,
+           tie + tfloat + tdiff + ours_only + theirs_only, tie, tfloat, tdiff, ours_only, theirs_only);
+    printf("result set=%s agree=%ld disagree=%ld tie=%ld tfloat=%ld tdiff=%ld ours_only=%ld embree_only=%ld\n",
+           set, agree, tie + tfloat + tdiff + ours_only + theirs_only, tie, tfloat, tdiff, ours_only, theirs_only);
+}
+
+/* How the walk spends its work, in an untimed pass: tree steps and hit tests
+ * per ray, and how many tests repeat a primitive already tested for the same
+ * ray.  A primitive listed in several leaves along the ray is tested in each
+ * (kdtree.c keeps no "mailbox"); the repeats say what one would save.  The
+ * tree's own hit callback is wrapped, so nothing in ray.c changes. */
+static struct {
+    int (*hit)(void *, int, const void *, double, double, double *);
+    unsigned long *mark;      /* per primitive: the last ray that tested it */
+    unsigned long ray;
+    unsigned long long tests, repeats;
+} rb_probe;
+
+static int rb_counting_hit(void *user, int i, const void *ray, double tmin, double tmax, double *t)
+{
+    rb_probe.tests++;
+    if (rb_probe.mark[i] == rb_probe.ray) rb_probe.repeats++;
+    rb_probe.mark[i] = rb_probe.ray;
+    return rb_probe.hit(user, i, ray, tmin, tmax, t);
+}
+
+static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
+{
+    kd_counters c = { 0, 0, 0 };
+    long i;
+    rb_probe.hit = s->prims.hit;
+    rb_probe.mark = calloc((size_t)nobj(s), sizeof *rb_probe.mark);
+    rb_probe.tests = rb_probe.repeats = 0;
+    if (!rb_probe.mark) rb_die("out of memory", NULL);
+    s->prims.hit = rb_counting_hit;
+    for (i = 0; i < n; i++) {
+        double o[3], d[3], tmax = INFINITY;
+        Ray r;
+        int k;
+        for (k = 0; k < 3; k++) o[k] = rays[i].o[k], d[k] = rays[i].d[k];
+        r.o = v3(o[0], o[1], o[2]);
+        r.d = v3(d[0], d[1], d[2]);
+        rb_probe.ray = (unsigned long)i + 1;
+        kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, &c);
+    }
+    s->prims.hit = rb_probe.hit;
+    free(rb_probe.mark);
+    printf("work       %.1f tree steps and %.2f hit tests per ray; %.1f%% of the tests repeat a "
+           "primitive already tested for that ray\n", (double)c.steps / n, (double)rb_probe.tests / n,
+           rb_probe.tests ? 100.0 * rb_probe.repeats / rb_probe.tests : 0.0);
+    printf("result set=%s steps_per_ray=%.2f tests_per_ray=%.3f repeat_pct=%.2f\n", set, (double)c.steps / n,
+           (double)rb_probe.tests / n, rb_probe.tests ? 100.0 * rb_probe.repeats / rb_probe.tests : 0.0);
+}
+
+/* Times both ways of tracing one set of rays through the built tree of s,
+ * and compares with Embree when the rays came with its answers.  `set`
+ * names them in the result lines. */
+static void rb_rays(Scene *s, const char *set, const RbRay *rays, long n)
+{
+    int *obj = malloc((size_t)n * sizeof *obj);
+    double *t = malloc((size_t)n * sizeof *t), full, bare;
+    long hits = 0, i;
+    if (!obj || !t) rb_die("out of memory for hits", NULL);
+    bare = rb_best(s, rays, n, 1, obj, t);
+    full = rb_best(s, rays, n, 0, obj, t);   /* last: its hits are compared */
+    for (i = 0; i < n; i++) hits += obj[i] >= 0;
+    printf("rays       %s: %ld rays, %ld hit (%.1f%%), one thread, best of %d\n", set, n, hits,
+           100.0 * hits / n, RB_REPEAT);
+    printf("traversal  nearest_hit %.3f s = %.2f Mrays/s; tree walk alone (kd_nearest) %.3f s = %.2f Mrays/s\n",
+           full, n / full * 1e-6, bare, n / bare * 1e-6);
+    printf("result set=%s rays=%ld hits=%ld seconds=%.5f mrays=%.3f bare_mrays=%.3f\n", set, n, hits,
+           full, n / full * 1e-6, n / bare * 1e-6);
+    rb_work(s, set, rays, n);
+    if (rays[0].prim != -2) rb_compare(s, set, rays, n, obj, t);
+    free(obj);
+    free(t);
+}
+
+/* The mesh, loaded and its tree built and described. */
+static void rb_mesh(Scene *s, const char *path)
+{
+    double secs;
+    rb_load_mesh(s, path);
+    secs = rb_build(s);
+    rb_tree_line(s, secs);
+}
+
+/* ------------------------------------------------------------ build scaling */
+
+/* Point (u, v) of a k x k grid on cube face f, pushed out onto the unit
+ * sphere: triangles of nearly even size everywhere, with no poles where
+ * hundreds of slivers meet as on a latitude-longitude sphere. */
+static vec rb_cube_point(int f, int u, int v, int k)
+{
+    double q[3], a = 2.0 * u / k - 1, b = 2.0 * v / k - 1;
+    int axis = f % 3;
+    q[axis] = f < 3 ? 1 : -1;
+    q[(axis + 1) % 3] = f < 3 ? a : b;   /* swapped on the far faces, so */
+    q[(axis + 2) % 3] = f < 3 ? b : a;   /* that all six wind the same way */
+    return unit(v3(q[0], q[1], q[2]));
+}
+
+/* A sphere of 12 k^2 triangles through ray.c's own add_vertex and
+ * add_triangle, so that the tree sees exactly what a loaded mesh gives it. */
+static void rb_cube_sphere(Scene *s, int k)
+{
+    int mat = rb_white(s), f, u, v;
+    for (f = 0; f < 6; f++) {
+        int base = s->nvert;
+        for (v = 0; v <= k; v++)
+            for (u = 0; u <= k; u++) add_vertex(s, rb_cube_point(f, u, v, k));
+        for (v = 0; v < k; v++)
+            for (u = 0; u < k; u++) {
+                int a = base + v * (k + 1) + u, b = a + 1, c = a + k + 1, d = c + 1;
+                add_triangle(s, a, b, d, -1, -1, -1, mat);
+                add_triangle(s, a, d, c, -1, -1, -1, mat);
+            }
+    }
+}
+
+/* Build time against N, and the exponent p of time ~ N^p by least squares
+ * on log time against log N.  Wald and Havran's O(N log N) build gives p a
+ * little above 1; p well above means some step grows faster than it should.
+ * Short builds are repeated and the fastest kept, as for rays; the 1M build
+ * runs once, as one run takes seconds and is hardly disturbed. */
+static void rb_build_table(long maxn)
+{
+    static const long sizes[] = { 10000, 30000, 100000, 300000, 1000000, 3000000 };
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, p;
+    int i, count = 0;
+    printf("Build time against N: cube-spheres, ray.c's triangles and clip callback, one thread\n");
+    printf("%10s %9s %5s %10s %9s %6s %9s %10s %9s\n", "triangles", "build s", "runs", "ns/tri", "nodes",
+           "depth", "refs/tri", "bytes/tri", "SAH cost");
+    for (i = 0; i < (int)(sizeof sizes / sizeof sizes[0]) && sizes[i] <= maxn; i++) {
+        int k = (int)floor(sqrt(sizes[i] / 12.0) + 0.5), runs = 0, n;
+        double best = HUGE_VAL, secs;
+        kd_info info;
+        Scene s;
+        default_scene(&s);
+        rb_cube_sphere(&s, k);
+        n = nobj(&s);
+        do {
+            if (s.tree) kd_free(s.tree), s.tree = NULL;
+            secs = rb_build(&s);
+            if (secs < best) best = secs;
+            runs++;
+        } while (runs < (best < 1 ? RB_REPEAT : best < 3 ? 2 : 1));
+        kd_describe(s.tree, &info);
+        printf("%10d %9.3f %5d %10.0f %9ld %6ld %9.2f %10.1f %9.2f\n", n, best, runs, best / n * 1e9,
+               info.nodes, info.max_depth, (double)info.prim_refs / n, (double)info.bytes / n,
+               info.sah_cost);
+        printf("result triangles=%d build_s=%.4f nodes=%ld depth=%ld refs_per_tri=%.3f bytes_per_tri=%.2f sah=%.3f\n",
+               n, best, info.nodes, info.max_depth, (double)info.prim_refs / n,
+               (double)info.bytes / n, info.sah_cost);
+        sx += log((double)n); sy += log(best);
+        sxx += log((double)n) * log((double)n); sxy += log((double)n) * log(best);
+        count++;
+        rb_free_scene(&s);
+    }
+    if (count < 2) {
+        printf("(one size only: no exponent)\n");
+        return;
+    }
+    p = (count * sxy - sx * sy) / (count * sxx - sx * sx);
+    printf("build time ~ N^%.3f (least squares on log-log, %d sizes)   target: exponent <= 1.15: %s\n",
+           p, count, p <= 1.15 ? "met" : "NOT MET");
+    printf("result exponent=%.4f\n", p);
+}
+
+/* ------------------------------------------------------------------ main */
+
+static long rb_count(const char *arg, long max)
+{
+    char *end;
+    long v = strtol(arg, &end, 10);
+    if (end == arg || *end || v < 1 || v > max) rb_die("expected a whole number, not", arg);
+    return v;
+}
+
+static void rb_usage(void)
+{
+    fputs("usage: raybench build [MAXN]\n"
+          "       raybench rays MESH.obj RAYS.bin...     (RAYHITS1, from embree_rays -out)\n"
+          "       raybench made MESH.obj W H N [VIEW.nff] (W x H primary and N random rays)\n", stderr);
+    exit(2);
+}
+
+int main(int argc, char **argv)
+{
+    Scene s;
+    if (argc < 2) rb_usage();
+    if (!strcmp(argv[1], "build") && argc <= 3) {
+        rb_build_table(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
+        return 0;
+    }
+    if (!strcmp(argv[1], "rays") && argc >= 4) {
+        int k;
+        rb_mesh(&s, argv[2]);
+        for (k = 3; k < argc; k++) {
+            /* the set's name: the file's, without directory and .bin */
+            char set[256], *dot;
+            const char *base = strrchr(argv[k], '/') ? strrchr(argv[k], '/') + 1 : argv[k];
+            long n;
+            RbRay *rays = rb_read_rayhits(argv[k], &n);
+            sprintf(set, "%.200s", base);
+            if ((dot = strrchr(set, '.')) && !strcmp(dot, ".bin")) *dot = 0;
+            rb_rays(&s, set, rays, n);
+            free(rays);
+        }
+    } else if (!strcmp(argv[1], "made") && (argc == 6 || argc == 7)) {
+        int w = (int)rb_count(argv[3], 32768), h = (int)rb_count(argv[4], 32768);
+        long n = rb_count(argv[5], 100000000);
+        RbRay *rays;
+        rb_mesh(&s, argv[2]);
+        rays = rb_primary(&s, w, h, argc == 7 ? argv[6] : NULL);
+        rb_rays(&s, "primary", rays, (long)w * h);
+        free(rays);
+        rays = rb_random(&s, n, 1);
+        rb_rays(&s, "random", rays, n);
+        free(rays);
+    } else
+        rb_usage();
+    rb_free_scene(&s);
+    return 0;
+}
