@@ -195,16 +195,16 @@ typedef struct {
  * the two roots come from q and c/q so that neither subtracts two nearly
  * equal numbers (Haines, Guenter, Jones, Akenine-Moller and Hunt, "Precision
  * Improvements for Ray/Sphere Intersection", Ray Tracing Gems, ch. 7, 2019). */
-static real hit_sphere(const Sphere *s, Ray r, real tmin)
+static real hit_sphere(const Sphere *sp, const Ray *r, real tmin)
 {
-    vec f = sub(r.o, s->cen);
-    real a = dot(r.d, r.d);
-    real b = -dot(f, r.d);                      /* half of -B in a t^2 + B t + C */
-    vec l = add(f, scale(b / a, r.d));
-    real disc = a * (s->rad * s->rad - dot(l, l));
+    vec f = sub(r->o, sp->cen);
+    real a = dot(r->d, r->d);
+    real b = -dot(f, r->d);                      /* half of -B in a t^2 + B t + C */
+    vec l = add(f, scale(b / a, r->d));
+    real disc = a * (sp->rad * sp->rad - dot(l, l));
     real c, q, t0, t1;
     if (!(disc >= 0)) return INFINITY;          /* also rejects NaN */
-    c = dot(f, f) - s->rad * s->rad;
+    c = dot(f, f) - sp->rad * sp->rad;
     q = b + (b >= 0 ? sqrt(disc) : -sqrt(disc));
     t0 = c / q;
     t1 = q / a;
@@ -227,13 +227,13 @@ static real hit_sphere(const Sphere *s, Ray r, real tmin)
  * itself to t0, level with the cone's middle, the quadratic solved from
  * there, and t0 added back: the same idea as the sphere's closest point.
  * The roots then come from q and C/q, so that neither subtracts. */
-static real hit_cone(const Cone *c, Ray r, real tmin)
+static real hit_cone(const Cone *c, const Ray *r, real tmin)
 {
-    real t0 = dot(sub(comb(c->len / 2, c->axis, c->base), r.o), r.d) / dot(r.d, r.d);
-    vec q = sub(comb(t0, r.d, r.o), c->base);
+    real t0 = dot(sub(comb(c->len / 2, c->axis, c->base), r->o), r->d) / dot(r->d, r->d);
+    vec q = sub(comb(t0, r->d, r->o), c->base);
     real k = (c->ra - c->rb) / c->len;
-    real qh = dot(q, c->axis), dh = dot(r.d, c->axis);
-    vec qx = comb(-qh, c->axis, q), dx = comb(-dh, c->axis, r.d); /* across the axis */
+    real qh = dot(q, c->axis), dh = dot(r->d, c->axis);
+    vec qx = comb(-qh, c->axis, q), dx = comb(-dh, c->axis, r->d); /* across the axis */
     real rq = c->rb + k * qh;                   /* radius at the origin's height */
     real A = dot(dx, dx) - k * k * dh * dh;
     real B = dot(qx, dx) - rq * k * dh;
@@ -285,14 +285,14 @@ static double det2(double a, double b, double c, double d)
  * by the same arithmetic in every triangle that shares it, and each side is
  * decided by an exact sign (det2), so the triangles around an edge or a
  * vertex tile the plane with no gap for a ray to slip through. */
-static int watertight_inside(vec a, vec b, vec c, Ray r)
+static int watertight_inside(vec a, vec b, vec c, const Ray *r)
 {
     double d[3], o[3], p[3][3], x[3], y[3], u, v, w, sx, sy;
     int kz, kx, ky, i, k;
     vec q[3];
     q[0] = a; q[1] = b; q[2] = c;
-    d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
-    o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
+    d[0] = r->d.x; d[1] = r->d.y; d[2] = r->d.z;
+    o[0] = r->o.x; o[1] = r->o.y; o[2] = r->o.z;
     kz = fabs(d[0]) > fabs(d[1]) ? (fabs(d[0]) > fabs(d[2]) ? 0 : 2) : (fabs(d[1]) > fabs(d[2]) ? 1 : 2);
     kx = (kz + 1) % 3;
     ky = (kx + 1) % 3;
@@ -326,29 +326,28 @@ static int watertight_inside(vec a, vec b, vec c, Ray r)
  *    the exact test watertight_inside() decides instead.  That is rare, so
  *    the common case keeps Moller and Trumbore's speed.
  * Returns 1 and t, u, v (barycentrics of v1 and v2) on a hit. */
-static int hit_triangle(const Scene *s, const Triangle *tr, Ray r, real tmax,
+static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
                         real *t, real *u, real *v)
 {
     vec v0 = s->vert[tr->v[0]], v1 = s->vert[tr->v[1]], v2 = s->vert[tr->v[2]];
-    vec e1 = sub(v1, v0), e2 = sub(v2, v0), p = cross(r.d, e2), tv, q;
-    real det = dot(e1, p), uu, vv, tt, slack;
-    if (tr->degenerate) return 0;
+    vec e1 = sub(v1, v0), e2 = sub(v2, v0), p = cross(r->d, e2), tv, q;
+    real det = dot(e1, p), sign = det < 0 ? -1 : 1, slack, uu, vv, tt;
+    if (tr->degenerate || isnan(det)) return 0;
     if (tr->cull) {                      /* the lecture's culling branch */
         if (!(det > 0)) return 0;
-    } else if (!(det != 0 && det == det)) /* the non-culling branch */
+    } else if (det == 0)                 /* the non-culling branch */
         return 0;
-    tv = sub(r.o, v0);
-    uu = dot(tv, p);
+    det *= sign;                         /* from here on det > 0 */
+    slack = (real)1e-7 * det;
+    tv = sub(r->o, v0);                   /* u, v and t, each times det */
+    uu = sign * dot(tv, p);
+    if (uu < -slack || uu > det + slack) return 0;
     q = cross(tv, e1);
-    vv = dot(r.d, q);
-    tt = dot(e2, q);
-    if (det < 0) { det = -det; uu = -uu; vv = -vv; tt = -tt; }
-    if (!(tt > 0)) return 0;                    /* behind the origin */
-    if (!(uu >= 0 && vv >= 0 && uu + vv <= det)) {
-        slack = (real)1e-7 * det;
-        if (!(uu >= -slack && vv >= -slack && uu + vv <= det + slack)) return 0;
-        if (!watertight_inside(v0, v1, v2, r)) return 0;
-    }
+    vv = sign * dot(r->d, q);
+    if (vv < -slack || uu + vv > det + slack) return 0;
+    tt = sign * dot(e2, q);
+    if (!(tt > 0)) return 0;             /* behind the origin, or NaN */
+    if ((uu < 0 || vv < 0 || uu + vv > det) && !watertight_inside(v0, v1, v2, r)) return 0;
     *t = tt / det;      /* compared after the division: a tie at tmax must be exact */
     if (!(*t <= tmax)) return 0;
     *u = uu / det;
@@ -369,7 +368,7 @@ static int degenerate(vec a, vec b, vec c)
 /* ------------------------------------------------------------ nearest hit */
 
 /* Object i against the ray: 1 and its t when hit with 0 < t <= tmax. */
-static int hit_object(const Scene *s, int i, Ray r, real tmax, real *t)
+static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
 {
     real u, v;
     int k;
@@ -403,7 +402,7 @@ static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
         const Triangle *tr = &s->tri[k];
         vec a = s->vert[tr->v[0]], b = s->vert[tr->v[1]], c = s->vert[tr->v[2]];
         real u, v, tt;
-        hit_triangle(s, tr, r, INFINITY, &tt, &u, &v);
+        hit_triangle(s, tr, &r, INFINITY, &tt, &u, &v);
         /* from the barycentrics, not o + t d: exact to the triangle's own
          * rounding, however far away the ray came from */
         h->p = add(add(scale(1 - u - v, a), scale(u, b)), scale(v, c));
@@ -512,7 +511,7 @@ static int kd_hit(void *user, int i, const void *ray, double tmin, double tmax, 
 {
     real tt;
     (void)tmin;             /* rays start off the surface; see spawn() */
-    if (!hit_object(user, i, *(const Ray *)ray, (real)tmax, &tt)) return 0;
+    if (!hit_object(user, i, ray, (real)tmax, &tt)) return 0;
     *t = tt;
     return 1;
 }
@@ -541,7 +540,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
         st->tests += c.tests;
     } else {
         for (i = 0; i < nobj(s); i++)
-            if (hit_object(s, i, r, t, &ti) && ti < t) { t = ti; best = i; }
+            if (hit_object(s, i, &r, t, &ti) && ti < t) { t = ti; best = i; }
         st->tests += (unsigned long long)nobj(s);
     }
     if (best < 0) return 0;
@@ -570,7 +569,7 @@ static int any_hit(const Scene *s, Ray r, real tmax, Stats *st)
     }
     for (i = 0; i < nobj(s); i++) {
         st->tests++;
-        if (hit_object(s, i, r, tmax, &t)) return 1;
+        if (hit_object(s, i, &r, tmax, &t)) return 1;
     }
     return 0;
 }

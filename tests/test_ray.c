@@ -40,6 +40,8 @@ static Sphere sphere(double x, double y, double z, double r)
 }
 
 static Ray ray(vec o, vec d) { Ray r; r.o = o; r.d = d; return r; }
+/* The same, for the intersection tests, which take the ray by pointer. */
+static const Ray *rp(vec o, vec d) { static Ray r; r.o = o; r.d = d; return &r; }
 
 /* The near root in long double, as a reference: 64-bit mantissa, and the
  * stable form, so its error is far below what is tested. */
@@ -69,7 +71,7 @@ static void test_sphere_far(void)
             double ox = 0.9 * cos(k * 2.4) * sqrt(k / 100.0), oz = 0.9 * sin(k * 2.4) * sqrt(k / 100.0);
             Sphere s = sphere(0, dist, 0, 1);
             Ray r = ray(v3(0, 0, 0), unit(v3(ox, dist, oz)));
-            double t = hit_sphere(&s, r, 0);
+            double t = hit_sphere(&s, &r, 0);
             double err = fabs(t - (double)exact_t(r.o, r.d, s.cen, 1));
             if (!(err <= worst)) worst = err;   /* NaN counts as worst */
         }
@@ -85,7 +87,7 @@ static void test_sphere_tiny(void)
     for (r = 1e-7; r < 1e-2; r *= 10) {
         Sphere s = sphere(0.3, 1000, -0.2, r);
         Ray ry = ray(v3(0, 0, 0), unit(sub(v3(0.3 + 0.5 * r, 1000, -0.2), v3(0, 0, 0))));
-        double t = hit_sphere(&s, ry, 0);
+        double t = hit_sphere(&s, &ry, 0);
         if (!isfinite(t)) misses++;
         else if (fabs(t - (double)exact_t(ry.o, ry.d, s.cen, r)) / 1000 > worst)
             worst = fabs(t - (double)exact_t(ry.o, ry.d, s.cen, r)) / 1000;
@@ -97,10 +99,10 @@ static void test_sphere_tiny(void)
 static void test_sphere_inside_and_miss(void)
 {
     Sphere s = sphere(1, 2, 3, 2);
-    double t_in = hit_sphere(&s, ray(v3(1, 2, 3), v3(0, 0, 1)), 0);
-    double t_off = hit_sphere(&s, ray(v3(1, 2.5, 3), v3(1, 0, 0)), 0);
-    double t_miss = hit_sphere(&s, ray(v3(1, 2, 6), v3(0, 1, 0)), 0);
-    double t_behind = hit_sphere(&s, ray(v3(1, 2, 6), v3(0, 0, 1)), 0);
+    double t_in = hit_sphere(&s, rp(v3(1, 2, 3), v3(0, 0, 1)), 0);
+    double t_off = hit_sphere(&s, rp(v3(1, 2.5, 3), v3(1, 0, 0)), 0);
+    double t_miss = hit_sphere(&s, rp(v3(1, 2, 6), v3(0, 1, 0)), 0);
+    double t_behind = hit_sphere(&s, rp(v3(1, 2, 6), v3(0, 0, 1)), 0);
     report(t_in == 2, "from the centre, t = radius", "t=%.17g want %g", t_in, 2);
     report(near(t_off, sqrt(4 - 0.25), 1e-15), "from inside, off centre", "t=%.17g want %.17g",
            t_off, sqrt(4 - 0.25));
@@ -164,7 +166,7 @@ static void test_triangle_scales(void)
         Scene s = tri_scene(0);
         real t, u, v;
         int k = tri(&s, v3(0, 0, 0), v3(L, 0, 0), v3(0, L, 0));
-        if (!hit_triangle(&s, &s.tri[k], ray(v3(0.25 * L, 0.25 * L, L), v3(0, 0, -1)), INFINITY, &t, &u, &v))
+        if (!hit_triangle(&s, &s.tri[k], rp(v3(0.25 * L, 0.25 * L, L), v3(0, 0, -1)), INFINITY, &t, &u, &v))
             misses++;
         else if (fabs(t / L - 1) > worst)
             worst = fabs(t / L - 1);
@@ -194,7 +196,7 @@ static void test_triangle_degenerate(void)
             /* aim at a point of the degenerate triangle's line */
             d = sub(comb((x >> 8) / 16777216.0, sub(s.vert[s.tri[k].v[2]], s.vert[s.tri[k].v[0]]),
                          s.vert[s.tri[k].v[0]]), o);
-            hits += hit_triangle(&s, &s.tri[k], ray(o, d), INFINITY, &t, &u, &v);
+            hits += hit_triangle(&s, &s.tri[k], rp(o, d), INFINITY, &t, &u, &v);
             nans += t != t || u != u || v != v;
         }
     report(hits == 0 && nans == 0, "degenerate triangles: 400000 rays at them, no hit, no NaN",
@@ -205,8 +207,8 @@ static void test_triangle_degenerate(void)
         Sphere sp = sphere(0, 0, 0, 1);
         double nan = strtod("nan", NULL);
         int k2 = tri(&g, v3(-1, -1, 0), v3(1, -1, 0), v3(0, 1, 0));
-        int h = hit_object(&g, 0, ray(v3(0, 0, 1), v3(nan, 0, -1)), INFINITY, &t)
-                + !isinf(hit_sphere(&sp, ray(v3(0, 0, 5), v3(0, nan, -1)), 0));
+        int h = hit_object(&g, 0, rp(v3(0, 0, 1), v3(nan, 0, -1)), INFINITY, &t)
+                + !isinf(hit_sphere(&sp, rp(v3(0, 0, 5), v3(0, nan, -1)), 0));
         (void)k2;
         report(h == 0, "a ray with a NaN direction hits nothing", "hits %g (want %g)", h, 0);
         free_scene(&g);
@@ -221,9 +223,9 @@ static void test_triangle_culling(void)
     int front, back, both;
     tri(&one, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));         /* normal +z */
     tri(&two, v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0));
-    front = hit_triangle(&one, &one.tri[0], ray(v3(.2, .2, 1), v3(0, 0, -1)), INFINITY, &t, &u, &v);
-    back = hit_triangle(&one, &one.tri[0], ray(v3(.2, .2, -1), v3(0, 0, 1)), INFINITY, &t, &u, &v);
-    both = hit_triangle(&two, &two.tri[0], ray(v3(.2, .2, -1), v3(0, 0, 1)), INFINITY, &t, &u, &v);
+    front = hit_triangle(&one, &one.tri[0], rp(v3(.2, .2, 1), v3(0, 0, -1)), INFINITY, &t, &u, &v);
+    back = hit_triangle(&one, &one.tri[0], rp(v3(.2, .2, -1), v3(0, 0, 1)), INFINITY, &t, &u, &v);
+    both = hit_triangle(&two, &two.tri[0], rp(v3(.2, .2, -1), v3(0, 0, 1)), INFINITY, &t, &u, &v);
     report(front && !back && both && near(u, .2, 1e-15) && near(v, .2, 1e-15),
            "culling branch: front only; two-sided by default; u, v right", "front %g back %g", front, back);
     free_scene(&one);
@@ -439,12 +441,12 @@ static void test_cones(void)
     double t1, t2, t3, t4, t5, t6;
     cyl.base = v3(0, 0, 0); cyl.axis = v3(0, 0, 1); cyl.len = 2; cyl.rb = cyl.ra = 1;
     cone = cyl; cone.len = 1; cone.ra = 0;                       /* apex at z = 1 */
-    t1 = hit_cone(&cyl, ray(v3(5, 0, 1), v3(-1, 0, 0)), 0);      /* from outside: 4 */
-    t2 = hit_cone(&cyl, ray(v3(0, 0, 1), v3(0, 1, 0)), 0);       /* from inside: 1 */
-    t3 = hit_cone(&cyl, ray(v3(5, 0, 3), v3(-1, 0, 0)), 0);      /* above its end: miss */
-    t4 = hit_cone(&cyl, ray(v3(0.5, 0, -1), v3(0, 0, 1)), 0);    /* along the axis, open ends: miss */
-    t5 = hit_cone(&cone, ray(v3(5, 0, 0.5), v3(-1, 0, 0)), 0);   /* radius 0.5 there: 4.5 */
-    t6 = hit_cone(&cone, ray(v3(3, 0, 1.5), v3(-1, 0, 0)), 0);   /* beyond the apex: miss */
+    t1 = hit_cone(&cyl, rp(v3(5, 0, 1), v3(-1, 0, 0)), 0);      /* from outside: 4 */
+    t2 = hit_cone(&cyl, rp(v3(0, 0, 1), v3(0, 1, 0)), 0);       /* from inside: 1 */
+    t3 = hit_cone(&cyl, rp(v3(5, 0, 3), v3(-1, 0, 0)), 0);      /* above its end: miss */
+    t4 = hit_cone(&cyl, rp(v3(0.5, 0, -1), v3(0, 0, 1)), 0);    /* along the axis, open ends: miss */
+    t5 = hit_cone(&cone, rp(v3(5, 0, 0.5), v3(-1, 0, 0)), 0);   /* radius 0.5 there: 4.5 */
+    t6 = hit_cone(&cone, rp(v3(3, 0, 1.5), v3(-1, 0, 0)), 0);   /* beyond the apex: miss */
     report(t1 == 4 && t2 == 1 && isinf(t3) && isinf(t4), "cylinder: outside, inside, past the end, along the axis",
            "t = %g and %g", t1, t2);
     report(near(t5, 4.5, 1e-15) && isinf(t6), "cone: the radius shrinks to the apex, and stops there",
@@ -455,7 +457,7 @@ static void test_cones(void)
             Cone far = cyl;
             double t;
             far.base = v3(0, d, 0);
-            t = hit_cone(&far, ray(v3(0, 0, 1), unit(v3(0.6, d, 0))), 0);
+            t = hit_cone(&far, rp(v3(0, 0, 1), unit(v3(0.6, d, 0))), 0);
             /* exact: the line x = 0.6 y / d meets x^2 + (y - d)^2 = 1 */
             {
                 long double k = 0.6L / d, A = 1 + k * k, B = -2.0L * d, C = (long double)d * d - 1;
