@@ -93,6 +93,14 @@ static vec cross(vec a, vec b)
 static vec comb(real a, vec A, vec B) { return add(B, scale(a, A)); }
 /* Multiply by the reciprocal, as minray's vunit does, for identical bits. */
 static vec unit(vec a) { return scale(1 / sqrt(dot(a, a)), a); }
+/* The index of the largest of |x|, |y|, |z|. */
+static int largest_axis(double x, double y, double z)
+{
+    x = fabs(x); y = fabs(y); z = fabs(z);
+    return x > y ? (x > z ? 0 : 2) : (y > z ? 1 : 2);
+}
+
+static void to3(vec a, double out[3]) { out[0] = a.x; out[1] = a.y; out[2] = a.z; }
 static real maxabs(vec a)
 {
     real m = fabs(a.x);
@@ -291,15 +299,15 @@ static int watertight_inside(vec a, vec b, vec c, const Ray *r)
     int kz, kx, ky, i, k;
     vec q[3];
     q[0] = a; q[1] = b; q[2] = c;
-    d[0] = r->d.x; d[1] = r->d.y; d[2] = r->d.z;
-    o[0] = r->o.x; o[1] = r->o.y; o[2] = r->o.z;
-    kz = fabs(d[0]) > fabs(d[1]) ? (fabs(d[0]) > fabs(d[2]) ? 0 : 2) : (fabs(d[1]) > fabs(d[2]) ? 1 : 2);
+    to3(r->d, d);
+    to3(r->o, o);
+    kz = largest_axis(d[0], d[1], d[2]);
     kx = (kz + 1) % 3;
     ky = (kx + 1) % 3;
     sx = d[kx] / d[kz];
     sy = d[ky] / d[kz];
     for (i = 0; i < 3; i++) {
-        p[i][0] = q[i].x; p[i][1] = q[i].y; p[i][2] = q[i].z;
+        to3(q[i], p[i]);
         for (k = 0; k < 3; k++) p[i][k] -= o[k];
         x[i] = p[i][kx] - sx * p[i][kz];
         y[i] = p[i][ky] - sy * p[i][kz];
@@ -425,8 +433,8 @@ static void box_disc(double lo[3], double hi[3], int count, vec c, vec n, real r
 {
     double cc[3], nn[3];
     int a;
-    cc[0] = c.x; cc[1] = c.y; cc[2] = c.z;
-    nn[0] = n.x; nn[1] = n.y; nn[2] = n.z;
+    to3(c, cc);
+    to3(n, nn);
     for (a = 0; a < 3; a++) {
         double e = r * sqrt(fmax(0, 1 - nn[a] * nn[a]));
         if (count == 0 || cc[a] - e < lo[a]) lo[a] = cc[a] - e;
@@ -472,8 +480,7 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
         return 1;
     }
     for (k = 0; k < 3; k++) {
-        vec p = s->vert[s->tri[t].v[k]];
-        poly[0][k][0] = p.x; poly[0][k][1] = p.y; poly[0][k][2] = p.z;
+        to3(s->vert[s->tri[t].v[k]], poly[0][k]);
     }
     for (a = 0; a < 3; a++)
         for (side = 0; side < 2; side++) {
@@ -532,8 +539,8 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
     if (s->tree) {
         double o[3], d[3], tmax = INFINITY;
         kd_counters c = { 0, 0, 0 };
-        o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
-        d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
+        to3(r.o, o);
+        to3(r.d, d);
         best = kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, &c);
         t = (real)tmax;
         st->steps += c.steps;
@@ -560,8 +567,8 @@ static int any_hit(const Scene *s, Ray r, real tmax, Stats *st)
         double o[3], d[3];
         kd_counters c = { 0, 0, 0 };
         int hit;
-        o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
-        d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
+        to3(r.o, o);
+        to3(r.d, d);
         hit = kd_any(s->tree, &s->prims, o, d, &r, 0, tmax, &c);
         st->steps += c.steps;
         st->tests += c.tests;
@@ -625,12 +632,25 @@ static int refract(vec d, vec n, real cosi, real eta, vec *t)
     return 1;
 }
 
-static vec trace(const Scene *s, Ray r, int depth, Stats *st);
+static vec trace(const Scene *s, Ray r, int depth, real weight, Stats *st);
+
+/* Whether to trace a secondary ray that adds k times its colour to a hit
+ * that itself counts `weight` in the pixel.  Not at the last level (depth 1:
+ * it would return black), and not when its weight in the pixel falls under
+ * half a step of an 8-bit channel, where it can hardly change a byte: Hall
+ * and Greenberg's adaptive depth (1983).  Without it, two facing mirrors or
+ * nested glass double the rays at every level, and -d 30 takes days; with
+ * it, minray's scene and depth 3 never come near the limit. */
+#define MIN_WEIGHT (1.0 / 512)
+static int worth_tracing(real k, real weight, int depth)
+{
+    return k > 0 && depth > 1 && k * weight >= MIN_WEIGHT;
+}
 
 /* Local light, then reflection and refraction by recursion: minray's model,
  * plus a Phong highlight for materials that have one.  The sums run in the
  * card's order so that the rounding is the card's too. */
-static vec shade(const Scene *s, Ray r, const Hit *h, int depth, Stats *st)
+static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Stats *st)
 {
     const Material *m = &s->mat[h->mat];
     vec n = h->n, color = s->ambient, spec = v3(0, 0, 0), c, t;
@@ -650,25 +670,26 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, Stats *st)
     c = scale(m->kl, m->color);                 /* emission */
     c = comb(m->kd, color, c);                  /* diffuse */
     if (m->shine > 0) c = comb(m->ks, spec, c); /* highlight */
-    if (m->ks > 0 && depth > 1) {               /* at depth 1 it would return black */
+    if (worth_tracing(m->ks, weight, depth)) {
         st->reflected++;
-        c = comb(m->ks, trace(s, spawn(h, reflect(r.d, n, cosi)), depth - 1, st), c);
+        c = comb(m->ks, trace(s, spawn(h, reflect(r.d, n, cosi)), depth - 1, m->ks * weight, st), c);
     }
-    if (m->kt > 0 && depth > 1 && refract(r.d, n, cosi, eta, &t)) {
+    if (worth_tracing(m->kt, weight, depth) && refract(r.d, n, cosi, eta, &t)) {
         st->refracted++;
-        c = comb(m->kt, trace(s, spawn(h, t), depth - 1, st), c);
+        c = comb(m->kt, trace(s, spawn(h, t), depth - 1, m->kt * weight, st), c);
     }
     return c;
 }
 
 /* The lecture's RayTrace(R).  depth counts down like minray's level: a ray
- * traced with depth 1 is a leaf of the recursion. */
-static vec trace(const Scene *s, Ray r, int depth, Stats *st)
+ * traced with depth 1 is a leaf of the recursion.  weight is how much the
+ * ray's colour counts in the pixel (1 for a primary ray). */
+static vec trace(const Scene *s, Ray r, int depth, real weight, Stats *st)
 {
     Hit h;
     if (depth <= 0) return v3(0, 0, 0);
     if (!nearest_hit(s, r, &h, st)) return s->background;
-    return shade(s, r, &h, depth, st);
+    return shade(s, r, &h, depth, weight, st);
 }
 
 /* ----------------------------------------------------------------- camera */
@@ -708,7 +729,7 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Stats *st)
         real dx, dy;
         sample_offset(k, s->cam.anchor, &dx, &dy);
         st->primary++;
-        sum = add(sum, trace(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), s->depth, st));
+        sum = add(sum, trace(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), s->depth, 1, st));
     }
     return scale((real)1 / spp, sum);
 }
@@ -836,6 +857,12 @@ static int numbers(Where w, const char *what, char **tok, int ntok, int first, i
     return 1;
 }
 
+static void out_of_memory(void)
+{
+    fprintf(stderr, "ray: out of memory\n");
+    exit(1);
+}
+
 /* Room for one more element in a growing array. */
 static void *grow(void *p, int *cap, int need, size_t size)
 {
@@ -843,7 +870,7 @@ static void *grow(void *p, int *cap, int need, size_t size)
     *cap = *cap ? 2 * *cap : 16;
     if (*cap < need) *cap = need;
     p = realloc(p, (size_t)*cap * size);
-    if (!p) { fprintf(stderr, "ray: out of memory\n"); exit(1); }
+    if (!p) out_of_memory();
     return p;
 }
 
@@ -914,61 +941,90 @@ static int inside2(const double *p, const double *a, const double *b, const doub
     return area2(a, b, p) >= 0 && area2(b, c, p) >= 0 && area2(c, a, p) >= 0;
 }
 
-/* A planar polygon, convex or not, as triangles, by ear clipping (Meisters,
- * "Polygons have ears", 1975): a corner whose triangle is convex and holds
- * no other corner can be cut off, and some corner always can.  A fan from
- * one vertex would be wrong for the gears' concave 144-gons.  The polygon
- * is projected on the plane of its normal's largest axis (Newell's normal,
- * robust for any simple polygon).  vi and ni are vertex and normal indices
- * (ni may be NULL). */
-static void triangulate(Scene *s, const int *vi, const int *ni, int n, int mat)
+/* A polygon's corners in 2-D, counter-clockwise: it is projected on the
+ * plane square to its normal's largest axis (Newell's normal, right for any
+ * simple polygon, concave or not). */
+static void flatten(const Scene *s, const int *vi, int n, double (*p)[2])
 {
-    double (*p)[2] = malloc((size_t)n * sizeof *p), nn[3] = { 0, 0, 0 };
-    int *idx = malloc((size_t)n * sizeof *idx), m = n, k, j, ax, ux, vx;
-    if (!p || !idx) { fprintf(stderr, "ray: out of memory\n"); exit(1); }
+    double nn[3] = { 0, 0, 0 }, c[3];
+    int k, ax, ux, vx;
     for (k = 0; k < n; k++) {
         vec a = s->vert[vi[k]], b = s->vert[vi[(k + 1) % n]];
         nn[0] += (a.y - b.y) * (a.z + b.z);
         nn[1] += (a.z - b.z) * (a.x + b.x);
         nn[2] += (a.x - b.x) * (a.y + b.y);
     }
-    ax = fabs(nn[0]) > fabs(nn[1]) ? (fabs(nn[0]) > fabs(nn[2]) ? 0 : 2) : (fabs(nn[1]) > fabs(nn[2]) ? 1 : 2);
-    ux = (ax + 1) % 3;                 /* (ux, vx, ax) is a right-handed cycle: */
-    vx = (ax + 2) % 3;                 /* counter-clockwise seen from +ax */
-    if (nn[ax] < 0) { j = ux; ux = vx; vx = j; }
+    ax = largest_axis(nn[0], nn[1], nn[2]);
+    ux = (ax + 1) % 3;            /* (ux, vx, ax) is right-handed: seen from */
+    vx = (ax + 2) % 3;            /* +ax, counter-clockwise is positive area */
+    if (nn[ax] < 0) { k = ux; ux = vx; vx = k; }
     for (k = 0; k < n; k++) {
-        vec a = s->vert[vi[k]];
-        double c[3];
-        c[0] = a.x; c[1] = a.y; c[2] = a.z;
+        to3(s->vert[vi[k]], c);
         p[k][0] = c[ux];
         p[k][1] = c[vx];
+    }
+}
+
+/* Corner k of the polygon idx[0..m-1] can be cut off: it turns left, and no
+ * other corner lies in the triangle it makes with its neighbours. */
+static int is_ear(double (*p)[2], const int *idx, int m, int k)
+{
+    const double *a = p[idx[(k + m - 1) % m]], *b = p[idx[k]], *c = p[idx[(k + 1) % m]];
+    int j;
+    if (area2(a, b, c) <= 0) return 0;                  /* reflex or flat */
+    for (j = 0; j < m; j++) {
+        const double *q = p[idx[j]];
+        if (inside2(q, a, b, c) && memcmp(q, a, sizeof *p) && memcmp(q, b, sizeof *p)
+            && memcmp(q, c, sizeof *p))
+            return 0;
+    }
+    return 1;
+}
+
+/* The triangle of corners i, j, k of the polygon. */
+static void add_corner_triangle(Scene *s, const int *vi, const int *ni, int i, int j, int k, int mat)
+{
+    add_triangle(s, vi[i], vi[j], vi[k], ni ? ni[i] : -1, ni ? ni[j] : -1, ni ? ni[k] : -1, mat);
+}
+
+/* Corners a..b of a convex polygon, closed by the edge b-a: the triangle
+ * a, m, b with m halfway, then the two arcs it leaves.  Unlike a fan from
+ * one corner, no vertex is shared by more than a few triangles, and they
+ * shrink towards the rim: a fan of thousands of slivers meeting at a point
+ * is the kd-tree's worst case (every cell near the point holds them all). */
+static void triangulate_arc(Scene *s, const int *vi, const int *ni, int a, int b, int mat)
+{
+    int m = a + (b - a) / 2;
+    if (b - a < 2) return;
+    add_corner_triangle(s, vi, ni, a, m, b, mat);
+    triangulate_arc(s, vi, ni, a, m, mat);
+    triangulate_arc(s, vi, ni, m, b, mat);
+}
+
+/* A planar polygon, convex or not, as triangles, by ear clipping (Meisters,
+ * "Polygons have ears", 1975): some corner can always be cut off, leaving a
+ * polygon one corner smaller.  A fan from one corner would be wrong for the
+ * gears' concave 144-gons; a convex polygon takes the O(n) way above.
+ * vi and ni are the corners' vertex and normal indices (ni may be NULL). */
+static void triangulate(Scene *s, const int *vi, const int *ni, int n, int mat)
+{
+    double (*p)[2] = malloc((size_t)n * sizeof *p);
+    int *idx = malloc((size_t)n * sizeof *idx), m = n, k, convex = 1;
+    if (!p || !idx) out_of_memory();
+    flatten(s, vi, n, p);
+    for (k = 0; k < n; k++) {
         idx[k] = k;
+        if (area2(p[(k + n - 1) % n], p[k], p[(k + 1) % n]) < 0) convex = 0;
     }
-    for (k = 0; m > 3; ) {
-        int tries, i0 = 0, i1 = 0, i2 = 0, ear = 0;
-        for (tries = 0; tries < m && !ear; tries++, k = (k + 1) % m) {
-            i0 = idx[(k + m - 1) % m]; i1 = idx[k]; i2 = idx[(k + 1) % m];
-            if (area2(p[i0], p[i1], p[i2]) <= 0) continue;      /* reflex or flat */
-            ear = 1;
-            for (j = 0; j < m && ear; j++) {
-                int q = idx[j];
-                if (q != i0 && q != i1 && q != i2 && inside2(p[q], p[i0], p[i1], p[i2])
-                    && memcmp(p[q], p[i0], sizeof p[q]) && memcmp(p[q], p[i1], sizeof p[q])
-                    && memcmp(p[q], p[i2], sizeof p[q]))
-                    ear = 0;
-            }
-            if (ear) break;
-        }
-        if (!ear) {   /* only flat or self-touching corners left: cut one anyway */
-            i0 = idx[(k + m - 1) % m]; i1 = idx[k]; i2 = idx[(k + 1) % m];
-        }
-        add_triangle(s, vi[i0], vi[i1], vi[i2], ni ? ni[i0] : -1, ni ? ni[i1] : -1, ni ? ni[i2] : -1, mat);
+    if (convex) triangulate_arc(s, vi, ni, 0, n - 1, mat);
+    for (k = 0; !convex && m > 2; m--) {
+        int tries;
+        for (tries = 0; m > 3 && tries < m && !is_ear(p, idx, m, k); tries++) k = (k + 1) % m;
+        /* tries == m: only flat or self-touching corners are left; cut one anyway */
+        add_corner_triangle(s, vi, ni, idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m], mat);
         memmove(idx + k, idx + k + 1, (size_t)(m - k - 1) * sizeof *idx);
-        m--;
-        if (k >= m) k = 0;
+        if (k >= m - 1) k = 0;
     }
-    add_triangle(s, vi[idx[0]], vi[idx[1]], vi[idx[2]], ni ? ni[idx[0]] : -1,
-                 ni ? ni[idx[1]] : -1, ni ? ni[idx[2]] : -1, mat);
     free(p);
     free(idx);
 }
@@ -1146,7 +1202,7 @@ static char *beside(const char *scene, const char *name)
     const char *slash = strrchr(scene, '/');
     size_t dir = name[0] == '/' || !slash ? 0 : (size_t)(slash - scene + 1);
     char *p = malloc(dir + strlen(name) + 1);
-    if (!p) exit(1);
+    if (!p) out_of_memory();
     memcpy(p, scene, dir);
     strcpy(p + dir, name);
     return p;
@@ -1318,7 +1374,7 @@ static int nff_polygon(Scene *s, Lexer *lx, int normals, int mat)
     n = (int)cnt;
     vi = malloc((size_t)n * sizeof *vi);
     ni = malloc((size_t)n * sizeof *ni);
-    if (!vi || !ni) exit(1);
+    if (!vi || !ni) out_of_memory();
     for (k = 0; k < n && ok; k++) {
         ok = nff_numbers(lx, "a polygon", normals ? 6 : 3, x);
         if (!ok) break;
@@ -1530,7 +1586,7 @@ static char *default_output(const char *scene)
     base = base ? base + 1 : scene;
     dot = strrchr(base, '.');
     out = malloc(strlen(base) + 5);
-    if (!out) exit(1);
+    if (!out) out_of_memory();
     sprintf(out, "%.*s.ppm", dot ? (int)(dot - base) : (int)strlen(base), base);
     return out;
 }

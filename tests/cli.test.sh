@@ -114,3 +114,10 @@ cat "$TMP/fifo" > "$TMP/from_fifo" &
 start=$(date +%s)
 ./ray -s 8000x8000 -n 64 -o "$TMP/no/such/dir/x.ppm" scenes/whitted.sph 2>/dev/null; rc=$?
 [ $rc -ne 0 ] && [ $(( $(date +%s) - start )) -lt 5 ] && ok "an unwritable -o fails at once" || bad "unwritable -o: exit $rc"
+
+# Nested glass at the largest depth: rays double at each level without the
+# weight cut-off (Hall and Greenberg); with it this takes milliseconds.
+printf 'camera 0 0 0 0 1 0 0 0 1 40\n0 4 0  1 1 1 1  0 .5 .5 0 1.5\n0 4 0  1 1 1 .5 0 .5 .5 0 1.5\nlight 0 0 5 1 1 1\n' > "$TMP/nested.sph"
+start=$(date +%s)
+./ray -s 32x32 -d 64 -o "$TMP/n.ppm" "$TMP/nested.sph"; rc=$?
+[ $rc -eq 0 ] && [ $(( $(date +%s) - start )) -lt 10 ] && ok "nested glass at depth 64 finishes" || bad "nested glass at depth 64: exit $rc"

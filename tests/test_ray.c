@@ -390,6 +390,29 @@ static void test_ear_clipping(void)
     }
 }
 
+/* A convex 4000-gon: n-2 triangles, the area exact, and no fan: no vertex
+ * in more than a few dozen triangles (a fan puts all 3998 at one corner,
+ * and a kd-tree over that takes minutes and gigabytes). */
+static void test_convex_polygon(void)
+{
+    Scene s = tri_scene(0);
+    int n = 4000, k, *vi = malloc(sizeof *vi * n), *uses = calloc(n, sizeof *uses), most = 0;
+    double sum = 0, area = 0.5 * n * sin(2 * PI / n);
+    for (k = 0; k < n; k++) vi[k] = add_vertex(&s, v3(cos(2 * PI * k / n), sin(2 * PI * k / n), 0));
+    triangulate(&s, vi, NULL, n, 0);
+    for (k = 0; k < s.ntri; k++) {
+        int j;
+        sum += tri_area(&s, k);
+        for (j = 0; j < 3; j++) if (++uses[s.tri[k].v[j]] > most) most = uses[s.tri[k].v[j]];
+    }
+    report(s.ntri == n - 2 && near(sum, area, 1e-12 * area) && most <= 2 * 12 + 2,
+           "a convex 4000-gon: n-2 triangles, exact area, no fan", "%g triangles at the busiest vertex, area error %.3g",
+           most, fabs(sum - area));
+    free(vi);
+    free(uses);
+    free_scene(&s);
+}
+
 /* NFF: the view angle spans the centres of the outer pixel columns. */
 static void test_nff_view(void)
 {
@@ -629,6 +652,7 @@ int main(void)
     test_triangle_culling();
     test_cones();
     test_ear_clipping();
+    test_convex_polygon();
     test_nff_view();
     test_obj();
     test_watertight(1);
