@@ -139,8 +139,7 @@ typedef struct { vec pos, color; int sphere; } Light;
 
 typedef struct {
     vec eye, right, up, fwd;  /* orthonormal frame */
-    real fov;                 /* horizontal, edge to edge, in degrees */
-    real tan_half;            /* tan(fov / 2), kept to spare a tan per ray */
+    real tan_half;            /* tan(fov / 2); fov: horizontal, edge to edge */
     real anchor;              /* 0.5: samples centred on the pixel; 0: on its corner */
 } Camera;
 
@@ -187,7 +186,7 @@ typedef struct {
 /* What --stats counts; each thread keeps its own and they are summed. */
 typedef struct {
     unsigned long long primary, shadow, reflected, refracted;
-    unsigned long long queries, nearest, hits;  /* all tree or loop queries; nearest-hit ones; their hits */
+    unsigned long long queries, nearest, hits;  /* all queries; nearest-hit ones; their hits */
     unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
     int threads;
 } Stats;
@@ -426,10 +425,9 @@ static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
     }
 }
 
-/* Grows the box [lo, hi] (count points so far) to take in a disc of
- * radius r about centre c, square to the unit vector n: along each axis the
- * disc reaches r sqrt(1 - n_axis^2). */
-static void box_disc(double lo[3], double hi[3], int count, vec c, vec n, real r)
+/* The box of a disc of radius r about centre c, square to the unit vector
+ * n: along each axis it reaches r sqrt(1 - n_axis^2) from the centre. */
+static void disc_box(vec c, vec n, real r, double lo[3], double hi[3])
 {
     double cc[3], nn[3];
     int a;
@@ -437,8 +435,18 @@ static void box_disc(double lo[3], double hi[3], int count, vec c, vec n, real r
     to3(n, nn);
     for (a = 0; a < 3; a++) {
         double e = r * sqrt(fmax(0, 1 - nn[a] * nn[a]));
-        if (count == 0 || cc[a] - e < lo[a]) lo[a] = cc[a] - e;
-        if (count == 0 || cc[a] + e > hi[a]) hi[a] = cc[a] + e;
+        lo[a] = cc[a] - e;
+        hi[a] = cc[a] + e;
+    }
+}
+
+/* Grows [lo, hi] to take in [lo2, hi2]. */
+static void box_union(double lo[3], double hi[3], const double lo2[3], const double hi2[3])
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        lo[a] = fmin(lo[a], lo2[a]);
+        hi[a] = fmax(hi[a], hi2[a]);
     }
 }
 
@@ -446,18 +454,26 @@ static void box_disc(double lo[3], double hi[3], int count, vec c, vec n, real r
 static void kd_bounds(void *user, int i, double lo[3], double hi[3])
 {
     const Scene *s = user;
+    double lo2[3], hi2[3];
     int k, j;
     switch (kind(s, i, &k)) {
-    case SPHERE:   /* a sphere's box is that of its three great discs */
-        for (j = 0; j < 3; j++) box_disc(lo, hi, j, s->sph[k].cen, v3(j == 0, j == 1, j == 2), s->sph[k].rad);
+    case SPHERE:
+        to3(sub(s->sph[k].cen, v3(s->sph[k].rad, s->sph[k].rad, s->sph[k].rad)), lo);
+        to3(add(s->sph[k].cen, v3(s->sph[k].rad, s->sph[k].rad, s->sph[k].rad)), hi);
         return;
-    case CONE:
-        box_disc(lo, hi, 0, s->cone[k].base, s->cone[k].axis, s->cone[k].rb);
-        box_disc(lo, hi, 1, comb(s->cone[k].len, s->cone[k].axis, s->cone[k].base), s->cone[k].axis, s->cone[k].ra);
+    case CONE:      /* the boxes of its two end circles */
+        disc_box(s->cone[k].base, s->cone[k].axis, s->cone[k].rb, lo, hi);
+        disc_box(comb(s->cone[k].len, s->cone[k].axis, s->cone[k].base), s->cone[k].axis,
+                 s->cone[k].ra, lo2, hi2);
+        box_union(lo, hi, lo2, hi2);
         return;
     }
-    for (j = 0; j < 3; j++)        /* a vertex: a disc of radius 0 */
-        box_disc(lo, hi, j, s->vert[s->tri[k].v[j]], v3(1, 0, 0), 0);
+    to3(s->vert[s->tri[k].v[0]], lo);
+    to3(s->vert[s->tri[k].v[0]], hi);
+    for (j = 1; j < 3; j++) {
+        to3(s->vert[s->tri[k].v[j]], lo2);
+        box_union(lo, hi, lo2, lo2);
+    }
 }
 
 /* The box of the part of a triangle inside [blo, bhi]: the triangle clipped
@@ -469,9 +485,9 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
 {
     const Scene *s = user;
     double poly[2][9][3];
-    int n = 3, k, a, side, cur = 0, t;
+    int n = 3, k, a, side, cur = 0, tri;
     kd_bounds(user, i, lo, hi);
-    if (kind(s, i, &t) != TRIANGLE) {
+    if (kind(s, i, &tri) != TRIANGLE) {
         for (a = 0; a < 3; a++) {
             if (lo[a] < blo[a]) lo[a] = blo[a];
             if (hi[a] > bhi[a]) hi[a] = bhi[a];
@@ -480,7 +496,7 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
         return 1;
     }
     for (k = 0; k < 3; k++) {
-        to3(s->vert[s->tri[t].v[k]], poly[0][k]);
+        to3(s->vert[s->tri[tri].v[k]], poly[0][k]);
     }
     for (a = 0; a < 3; a++)
         for (side = 0; side < 2; side++) {
@@ -672,7 +688,8 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, St
     if (m->shine > 0) c = comb(m->ks, spec, c); /* highlight */
     if (worth_tracing(m->ks, weight, depth)) {
         st->reflected++;
-        c = comb(m->ks, trace(s, spawn(h, reflect(r.d, n, cosi)), depth - 1, m->ks * weight, st), c);
+        vec mirror = reflect(r.d, n, cosi);
+        c = comb(m->ks, trace(s, spawn(h, mirror), depth - 1, m->ks * weight, st), c);
     }
     if (worth_tracing(m->kt, weight, depth) && refract(r.d, n, cosi, eta, &t)) {
         st->refracted++;
@@ -918,15 +935,15 @@ static int add_normal(Scene *s, vec n)
 /* Vertices a, b, c and normals na, nb, nc (-1: none) by index. */
 static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, int mat)
 {
-    Triangle *t;
+    Triangle *tr;
     s->tri = grow(s->tri, &s->captri, s->ntri + 1, sizeof *s->tri);
-    t = &s->tri[s->ntri++];
-    t->v[0] = a; t->v[1] = b; t->v[2] = c;
+    tr = &s->tri[s->ntri++];
+    tr->v[0] = a; tr->v[1] = b; tr->v[2] = c;
     if (na < 0 || nb < 0 || nc < 0) na = nb = nc = -1;
-    t->n[0] = na; t->n[1] = nb; t->n[2] = nc;
-    t->mat = mat;
-    t->cull = (char)s->cull;
-    t->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
+    tr->n[0] = na; tr->n[1] = nb; tr->n[2] = nc;
+    tr->mat = mat;
+    tr->cull = (char)s->cull;
+    tr->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
 }
 
 /* Twice the signed area of the 2-D triangle a b c. */
@@ -982,7 +999,8 @@ static int is_ear(double (*p)[2], const int *idx, int m, int k)
 }
 
 /* The triangle of corners i, j, k of the polygon. */
-static void add_corner_triangle(Scene *s, const int *vi, const int *ni, int i, int j, int k, int mat)
+static void add_corner_triangle(Scene *s, const int *vi, const int *ni, int i, int j, int k,
+                                int mat)
 {
     add_triangle(s, vi[i], vi[j], vi[k], ni ? ni[i] : -1, ni ? ni[j] : -1, ni ? ni[k] : -1, mat);
 }
@@ -1046,8 +1064,10 @@ static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
 static int check_cone(Scene *s, Where w, const real *x, int mat)
 {
     vec base = v3(x[0], x[1], x[2]), apex = v3(x[4], x[5], x[6]);
-    if (!(x[3] >= 0 && x[7] >= 0 && x[3] + x[7] > 0)) return fail(w, "cone radii must be >= 0 and not both 0", NULL);
-    if (!(dot(sub(apex, base), sub(apex, base)) > 0)) return fail(w, "cone base and apex coincide", NULL);
+    if (!(x[3] >= 0 && x[7] >= 0 && x[3] + x[7] > 0))
+        return fail(w, "cone radii must be >= 0 and not both 0", NULL);
+    if (!(dot(sub(apex, base), sub(apex, base)) > 0))
+        return fail(w, "cone base and apex coincide", NULL);
     add_cone(s, base, x[3], apex, x[7], mat);
     return 1;
 }
@@ -1066,12 +1086,16 @@ static int material8(Scene *s, Where w, const real *v, int *mat)
 /* One sphere: minray's 12 numbers in minray's order. */
 static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
 {
-    real v[12], m[8];
-    int mat, k;
+    real v[12];
+    int mat;
     if (!numbers(w, "a sphere", tok, ntok, 0, 12, v)) return 0;
     if (!(v[6] > 0)) return fail(w, "sphere radius must be positive", tok[6]);
-    for (k = 0; k < 8; k++) m[k] = v[k < 3 ? 3 + k : 4 + k];   /* all but the radius */
-    if (!material8(s, w, m, &mat)) return 0;
+    {
+        real m[8];          /* the material: all the fields after the centre but the radius */
+        m[0] = v[3]; m[1] = v[4]; m[2] = v[5];
+        m[3] = v[7]; m[4] = v[8]; m[5] = v[9]; m[6] = v[10]; m[7] = v[11];
+        if (!material8(s, w, m, &mat)) return 0;
+    }
     add_sphere(s, v3(v[0], v[1], v[2]), v[6], mat);
     return 1;
 }
@@ -1081,10 +1105,11 @@ static int set_camera(Scene *s, Where w, const real *v)
     Camera *c = &s->cam;
     vec at = v3(v[3], v[4], v[5]), up = v3(v[6], v[7], v[8]);
     c->eye = v3(v[0], v[1], v[2]);
-    c->fov = v[9];
-    if (!(dot(sub(at, c->eye), sub(at, c->eye)) > 0)) return fail(w, "camera looks at its own eye", NULL);
-    if (!(c->fov > 0 && c->fov < 180)) return fail(w, "field of view must be between 0 and 180 degrees", NULL);
-    c->tan_half = tan(c->fov * PI / 360);
+    if (!(dot(sub(at, c->eye), sub(at, c->eye)) > 0))
+        return fail(w, "camera looks at its own eye", NULL);
+    if (!(v[9] > 0 && v[9] < 180))
+        return fail(w, "field of view must be between 0 and 180 degrees", NULL);
+    c->tan_half = tan(v[9] * PI / 360);
     c->fwd = unit(sub(at, c->eye));
     c->right = cross(c->fwd, up);
     if (!(dot(c->right, c->right) > 0)) return fail(w, "camera up is parallel to its view", NULL);
@@ -1107,16 +1132,23 @@ static int check_size(double fw, double fh, int *width, int *height)
     return 1;
 }
 
-/* Splits a line into at most max blank-separated tokens; '#' starts a
- * comment.  Returns max + 1 when there are more. */
+static int blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+/* Splits a line in place into at most max blank-separated tokens; '#'
+ * starts a comment.  Returns max + 1 when there are more. */
 static int tokens(char *line, char **tok, int max)
 {
     int n = 0;
-    char *p = strchr(line, '#');
-    if (p) *p = 0;
-    for (p = strtok(line, " \t\r\n"); p && n < max; p = strtok(NULL, " \t\r\n"))
+    char *p = line;
+    for (;;) {
+        while (blank(*p)) p++;
+        if (!*p || *p == '#') return n;
+        if (n == max) return max + 1;
         tok[n++] = p;
-    return p ? max + 1 : n;
+        while (*p && *p != '#' && !blank(*p)) p++;
+        if (*p == '#') { *p = 0; return n; }
+        if (*p) *p++ = 0;
+    }
 }
 
 /* Reads the next line of f into line; 0 at the end or on an over-long line
@@ -1125,7 +1157,11 @@ static int next_line(FILE *f, char *line, int size, Where *w, int *ok)
 {
     if (!fgets(line, size, f)) return 0;
     w->line++;
-    if (!strchr(line, '\n') && !feof(f)) return *ok = fail(*w, "line too long", NULL);
+    if (!strchr(line, '\n') && !feof(f)) {
+        char msg[64];
+        sprintf(msg, "line longer than %d characters", size - 2);
+        return *ok = fail(*w, msg, NULL);
+    }
     return 1;
 }
 
@@ -1154,27 +1190,31 @@ static int obj_corner(Where w, char *c, int nv, int nn, int *v, int *n)
 /* Wavefront OBJ: v, vn and f (any number of corners); every other statement
  * is skipped with one warning for the file.  `from` is the scene line that
  * asked for it, for the message when it cannot be opened. */
-#define OBJ_MAXCORNERS 1024
+#define OBJ_LINE 65536                  /* room for faces of thousands of corners */
 static int load_obj(Scene *s, const char *file, int mat, Where from)
 {
-    static char *tok[OBJ_MAXCORNERS + 2];
-    char line[16384], first_skipped[32] = "";
-    int vi[OBJ_MAXCORNERS], ni[OBJ_MAXCORNERS], v0 = s->nvert, n0 = s->nnorm, ok = 1, skipped = 0, skipped_line = 0;
+    int max = OBJ_LINE / 2, v0 = s->nvert, n0 = s->nnorm, ok = 1, skipped = 0, skipped_line = 0;
+    char *line = malloc(OBJ_LINE), **tok = malloc(sizeof *tok * (max + 1)), first_skipped[32] = "";
+    int *vi = malloc(sizeof *vi * max), *ni = malloc(sizeof *ni * max);
     Where w;
     FILE *f = fopen(file, "r");
-    if (!f) return fail(from, "cannot open mesh", strerror(errno));
+    if (!line || !tok || !vi || !ni) out_of_memory();
+    if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
     w.file = file;
     w.line = 0;
-    while (ok && next_line(f, line, sizeof line, &w, &ok)) {
-        int n = tokens(line, tok, OBJ_MAXCORNERS + 1), k, with_normals = 1;
+    while (ok && next_line(f, line, OBJ_LINE, &w, &ok)) {
+        int n = tokens(line, tok, max), k, with_normals = 1;
         real x[3];
         if (n == 0) continue;
-        if (n > OBJ_MAXCORNERS) { ok = fail(w, "face with more than 1023 corners", NULL); break; }
-        if (!strcmp(tok[0], "v") && n == 5) n = 4;     /* an optional w, unused */
-        if (!strcmp(tok[0], "v")) ok = numbers(w, "v", tok, n, 1, 3, x) && add_vertex(s, v3(x[0], x[1], x[2])) >= 0;
-        else if (!strcmp(tok[0], "vn")) ok = numbers(w, "vn", tok, n, 1, 3, x) && add_normal(s, v3(x[0], x[1], x[2])) >= 0;
-        else if (!strcmp(tok[0], "f")) {
-            if (n < 4) { ok = fail(w, "a face needs 3 corners or more", NULL); break; }
+        if (n > max) ok = fail(w, "too many fields", NULL);
+        else if (!strcmp(tok[0], "v") || !strcmp(tok[0], "vn")) {
+            int normal = tok[0][1] == 'n';
+            /* a vertex may go on with w, or with a colour: both unused */
+            ok = numbers(w, tok[0], tok, normal || n < 4 ? n : 4, 1, 3, x);
+            if (ok && normal) add_normal(s, v3(x[0], x[1], x[2]));
+            if (ok && !normal) add_vertex(s, v3(x[0], x[1], x[2]));
+        } else if (!strcmp(tok[0], "f")) {
+            if (n < 4) ok = fail(w, "a face needs 3 corners or more", NULL);
             for (k = 1; k < n && ok; k++) {
                 ok = obj_corner(w, tok[k], s->nvert - v0, s->nnorm - n0, &vi[k - 1], &ni[k - 1]);
                 vi[k - 1] += v0;
@@ -1187,12 +1227,12 @@ static int load_obj(Scene *s, const char *file, int mat, Where from)
             sprintf(first_skipped, "%.20s", tok[0]);
         }
     }
-    fclose(f);
-    if (ok && skipped) {
-        w.line = skipped_line;
-        fprintf(stderr, "%s:%d: warning: skipped %d statement%s that are not v, vn or f (the first: %s)\n",
+    if (f) fclose(f);
+    if (ok && skipped)
+        fprintf(stderr, "%s:%d: warning: skipped %d statement%s that are not v, vn or f"
+                " (the first: %s)\n",
                 file, skipped_line, skipped, skipped == 1 ? "" : "s", first_skipped);
-    }
+    free(line); free(tok); free(vi); free(ni);
     return ok;
 }
 
@@ -1219,13 +1259,19 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
                && (check_size(v[0], v[1], &s->w, &s->h) || fail(w, SIZE_RULE, NULL));
     if (!strcmp(k, "depth")) {
         if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 1 && v[0] <= 64 && v[0] == floor(v[0]))) return fail(w, "depth must be a whole number from 1 to 64", tok[1]);
+        if (!(v[0] >= 1 && v[0] <= 64 && v[0] == floor(v[0])))
+            return fail(w, "depth must be a whole number from 1 to 64", tok[1]);
         s->depth = (int)v[0];
         return 1;
     }
-    if (!strcmp(k, "ambient") || !strcmp(k, "background")) {
+    if (!strcmp(k, "ambient")) {
         if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
-        *(k[0] == 'a' ? &s->ambient : &s->background) = v3(v[0], v[1], v[2]);
+        s->ambient = v3(v[0], v[1], v[2]);
+        return 1;
+    }
+    if (!strcmp(k, "background")) {
+        if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
+        s->background = v3(v[0], v[1], v[2]);
         return 1;
     }
     if (!strcmp(k, "camera"))
@@ -1236,9 +1282,10 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
         return 1;
     }
     if (!strcmp(k, "pixel")) {
-        if (ntok != 2 || (strcmp(tok[1], "corner") && strcmp(tok[1], "centre") && strcmp(tok[1], "center")))
+        if (ntok != 2
+            || (strcmp(tok[1], "corner") && strcmp(tok[1], "centre") && strcmp(tok[1], "center")))
             return fail(w, "expected `pixel corner` or `pixel centre`", NULL);
-        s->cam.anchor = tok[1][0] == 'c' && tok[1][1] == 'o' ? 0 : (real)0.5;
+        s->cam.anchor = !strcmp(tok[1], "corner") ? 0 : (real)0.5;
         return 1;
     }
     if (!strcmp(k, "sided")) {
@@ -1305,8 +1352,6 @@ static int load_sph(Scene *s, FILE *f, Where w)
  * `again` hands the last token out once more, for a look ahead. */
 typedef struct { FILE *f; Where w; int c, again; char tok[256]; } Lexer;
 
-static int blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
-
 /* The next token into lx->tok: 1, or 0 at the end of the file, or -1 after
  * saying what is wrong. */
 static int next_token(Lexer *lx)
@@ -1320,7 +1365,10 @@ static int next_token(Lexer *lx)
         while (lx->c != '\n' && lx->c != EOF) lx->c = getc(lx->f);
     }
     for (; lx->c != EOF && !blank(lx->c); lx->c = getc(lx->f)) {
-        if (n == (int)sizeof lx->tok - 1) return fail(lx->w, "token longer than 255 characters", NULL) - 1;
+        if (n == (int)sizeof lx->tok - 1) {
+            fail(lx->w, "token longer than 255 characters", NULL);
+            return -1;
+        }
         lx->tok[n++] = (char)lx->c;
     }
     lx->tok[n] = 0;
@@ -1350,15 +1398,18 @@ static int nff_view(Scene *s, Lexer *lx)
     int seen = 0, k, got = 1;
     while (seen != 63 && (got = next_token(lx)) > 0) {
         for (k = 0; k < 6 && strcmp(lx->tok, names[k]); k++) continue;
-        if (k == 6) return fail(lx->w, "expected from, at, up, angle, hither or resolution", lx->tok);
+        if (k == 6)
+            return fail(lx->w, "expected from, at, up, angle, hither or resolution", lx->tok);
         if (seen & 1 << k) return fail(lx->w, "said twice in the view block", names[k]);
         seen |= 1 << k;
         if (!nff_numbers(lx, names[k], counts[k], x[k])) return 0;
     }
     if (got < 0) return 0;
-    if (seen != 63) return fail(lx->w, "the view block needs from, at, up, angle, hither and resolution", NULL);
+    if (seen != 63)
+        return fail(lx->w, "the view block needs from, at, up, angle, hither and resolution", NULL);
     if (!check_size(x[5][0], x[5][1], &s->w, &s->h)) return fail(lx->w, SIZE_RULE, NULL);
-    if (!(x[3][0] > 0 && x[3][0] < 180)) return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
+    if (!(x[3][0] > 0 && x[3][0] < 180))
+        return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
     for (k = 0; k < 9; k++) v[k] = x[k / 3][k % 3];   /* from, at, up */
     v[9] = 2 * atan(tan(x[3][0] * PI / 360) * s->w / (s->w > 1 ? s->w - 1 : 1)) * 180 / PI;
     return set_camera(s, lx->w, v);
@@ -1370,7 +1421,8 @@ static int nff_polygon(Scene *s, Lexer *lx, int normals, int mat)
     real x[6], cnt;
     int n, k, *vi, *ni, ok = 1;
     if (!nff_numbers(lx, normals ? "pp" : "p", 1, &cnt)) return 0;
-    if (!(cnt >= 3 && cnt <= 1e6 && cnt == floor(cnt))) return fail(lx->w, "a polygon needs 3 or more corners", lx->tok);
+    if (!(cnt >= 3 && cnt <= 1e6 && cnt == floor(cnt)))
+        return fail(lx->w, "a polygon needs from 3 to 1000000 corners", lx->tok);
     n = (int)cnt;
     vi = malloc((size_t)n * sizeof *vi);
     ni = malloc((size_t)n * sizeof *ni);
@@ -1398,6 +1450,15 @@ static int nff_light(Scene *s, Lexer *lx)
     lx->again = got > 0;
     if (got > 0 && strchr("+-.0123456789", lx->tok[0]) && !nff_numbers(lx, "l", 3, rgb)) return 0;
     add_light(s, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]), -1);
+    return 1;
+}
+
+/* b r g b: the colour of rays that hit nothing. */
+static int nff_background(Scene *s, Lexer *lx)
+{
+    real x[3];
+    if (!nff_numbers(lx, "b", 3, x)) return 0;
+    s->background = v3(x[0], x[1], x[2]);
     return 1;
 }
 
@@ -1433,7 +1494,6 @@ static int nff_cone(Scene *s, Lexer *lx, int mat)
 static int load_nff(Scene *s, FILE *f, Where w)
 {
     Lexer lx;
-    real x[3];
     int mat = -1, k, ok = 1, got = 1;
     double intensity;
     lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.again = 0;
@@ -1445,7 +1505,7 @@ static int load_nff(Scene *s, FILE *f, Where w)
             mat = add_material(s, m);
         }
         if (!strcmp(t, "v")) ok = nff_view(s, &lx);
-        else if (!strcmp(t, "b")) { if ((ok = nff_numbers(&lx, t, 3, x))) s->background = v3(x[0], x[1], x[2]); }
+        else if (!strcmp(t, "b")) ok = nff_background(s, &lx);
         else if (!strcmp(t, "l")) ok = nff_light(s, &lx);
         else if (!strcmp(t, "f")) ok = nff_material(s, &lx, &mat);
         else if (!strcmp(t, "s")) ok = nff_sphere(s, &lx, mat);
@@ -1615,7 +1675,8 @@ static void print_stats(const Scene *s, const Stats *st, int spp, double load, d
     if (s->tree) {
         kd_info k;
         kd_describe(s->tree, &k);
-        fprintf(stderr, "kd-tree    %ld nodes, %ld leaves (%ld empty), depth %ld, %.2f objects per leaf,\n"
+        fprintf(stderr, "kd-tree    %ld nodes, %ld leaves (%ld empty), depth %ld,"
+                " %.2f objects per leaf,\n"
                 "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
                 k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf,
                 k.bytes / 1e6, k.sah_cost, build);
@@ -1628,7 +1689,8 @@ static void print_stats(const Scene *s, const Stats *st, int spp, double load, d
     fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
             st->queries ? (double)st->tests / st->queries : 0.0,
             st->queries ? (double)st->steps / st->queries : 0.0);
-    fprintf(stderr, "time       %.3f s, %.2f Mrays/s\n", seconds, seconds > 0 ? rays / seconds * 1e-6 : 0.0);
+    fprintf(stderr, "time       %.3f s, %.2f Mrays/s\n", seconds,
+            seconds > 0 ? rays / seconds * 1e-6 : 0.0);
 }
 
 static void free_scene(Scene *s)
@@ -1676,13 +1738,17 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
         else if (!strcmp(a, "--p3")) plain = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
-        else if (!strcmp(a, "--accel") && next && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
+        else if (!strcmp(a, "--accel") && next
+                 && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
             accel = argv[++i];
         else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "ray: unknown option, or a bad or missing value: %s\n", a);
             usage(stderr);
             return 2;
-        } else if (scene) { fprintf(stderr, "ray: one scene only (%s and %s)\n", scene, a); return 2; }
+        } else if (scene) {
+            fprintf(stderr, "ray: one scene only (%s and %s)\n", scene, a);
+            return 2;
+        }
         else scene = a;
     }
     if (!scene) { usage(stderr); return 2; }

@@ -75,7 +75,7 @@ view='v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 45\nhither 1\nresolution 8 8\n'
 bad_nff "unknown entity" "unknown NFF entity: q" "$view""q 1 2 3\n"
 bad_nff "not a number" "not a number: x" "$view""s 0 0 x 1\n"
 bad_nff "file ends inside a polygon" "the file ends inside: a polygon" "$view""p 4\n0 0 0\n1 0 0\n1 1 0\n"
-bad_nff "polygon of 2 corners" "a polygon needs 3 or more corners" "$view""p 2\n0 0 0\n1 0 0\n"
+bad_nff "polygon of 2 corners" "a polygon needs from 3 to 1000000 corners" "$view""p 2\n0 0 0\n1 0 0\n"
 bad_nff "negative sphere radius" "sphere radius must be positive" "$view""s 0 0 0 -1\n"
 bad_nff "bad view keyword" "expected from, at, up" "v\nfrom 0 0 0\nlook 1 2 3\n"
 bad_nff "error on the right line" "" "$view""# comment\n\ns 0 0 0 1\ns 0 0 nan 1\n"
