@@ -17,4 +17,6 @@ done <<'LIST'
 minray_96_n4         -s 96x96 -n 4 scenes/minray.sph
 whitted_160x120_n4   -s 160x120 -n 4 scenes/whitted.sph
 whitted_160x120_d1   -s 160x120 -d 1 scenes/whitted.sph
+mesh_160x120_n2      -s 160x120 -n 2 scenes/mesh.sph
+demo_nff_128x96_n2   -s 128x96 -n 2 scenes/demo.nff
 LIST

@@ -497,6 +497,38 @@ static void test_cones(void)
            "cone normal tilts with the slope", "n = (%.17g, ., %.17g)", n.x, n.z);
 }
 
+/* No NaN or infinity ever reaches a pixel: trace() itself is checked,
+ * since to_byte() would quietly turn a NaN into black.  The scenes include
+ * the awkward cases: the eye inside glass, zero vertex normals, a glass of
+ * index 1, grazing cones, every kind of object. */
+static void test_no_nan(void)
+{
+    static const char *const files[] = { "scenes/minray.sph", "scenes/whitted.sph",
+                                         "scenes/mesh.sph", "scenes/demo.nff", NULL };
+    const char *odd = write_tmp("odd.nff",
+        "v\nfrom 0 0 0\nat 0 1 0\nup 0 0 1\nangle 90\nhither 1\nresolution 32 32\nl 0 0 0\n"
+        "f 1 1 1 .2 .4 5 .8 1\ns 0 0 0 3\ns 0 2 0 .5\nf 1 1 1 .5 .5 10 .5 1.5\n"
+        "pp 3\n-1 2 -1 0 0 0\n1 2 -1 0 0 0\n0 2 1 0 0 0\nc 0 2.5 -2 1 0 2.5 2 0\n");
+    int f, bad = 0, pixels = 0;
+    for (f = 0; f < 5; f++) {
+        Scene s;
+        Stats st;
+        int i, j, W = 48;
+        memset(&st, 0, sizeof st);
+        if (!load_scene(&s, files[f] ? files[f] : odd)) { bad++; continue; }
+        build_tree(&s, "auto");
+        for (j = 0; j < W; j++)
+            for (i = 0; i < W; i++) {
+                vec c = trace(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), s.depth, 1, &st);
+                bad += !isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z);
+                pixels++;
+            }
+        free_scene(&s);
+    }
+    report(bad == 0, "no NaN or infinity from trace() in five scenes, odd cases included",
+           "%g bad of %g pixels", bad, pixels);
+}
+
 static void test_camera(void)
 {
     Scene s;
@@ -647,6 +679,7 @@ int main(void)
     test_sphere_inside_and_miss();
     test_refraction();
     test_camera();
+    test_no_nan();
     test_triangle_scales();
     test_triangle_degenerate();
     test_triangle_culling();
