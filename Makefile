@@ -1,5 +1,6 @@
 # make          build everything with -O2 (override: make CC=clang CFLAGS=-O3)
 # make test     the test suite; ends with "N passed, N failed"
+# make stress   longer runs than make test: more kd-tree rays, every SPD scene
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)
 # make clean
@@ -26,11 +27,14 @@ tools/ppmdiff: tools/ppmdiff.c
 test: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/run.sh
 
+stress: all
+	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/stress.sh
+
 bench: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash bench/run.sh
 
 clean:
 	rm -rf $(PROGS) build bench/out
 
-.PHONY: all test bench clean golf
+.PHONY: all test stress bench clean golf
 -include golf/golf.mk

@@ -29,10 +29,12 @@
  * through a child is the ratio of their areas.  COST_STEP is one traversal
  * step, COST_TEST one call of the hit callback; only their ratio shapes the
  * tree, a larger COST_TEST giving deeper trees with fewer primitives per
- * leaf and more references.  The ratio was measured, not guessed: on the
- * 100k-triangle sphere of bench/kdbench.c, ratios 0.75, 1, 1.25, 1.5, 2, 3
- * gave 4.3, 4.2, 4.1, 4.2, 3.9, 3.8 Mrays/s (5.2, 5.2, 5.1, 5.0, 4.9, 4.7
- * with perfect splits): flat up to about 1.5, falling beyond.  We take 1,
+ * leaf and more references.  The ratio was measured, not guessed: on a
+ * 100k-triangle sphere (a test program since folded into bench/raybench.c),
+ * ratios 0.75, 1, 1.25, 1.5, 2, 3 gave 4.3, 4.2, 4.1, 4.2, 3.9, 3.8 Mrays/s
+ * (5.2, 5.2, 5.1, 5.0, 4.9, 4.7 with perfect splits), and ray.c's own
+ * triangles later gave the same flat picture (8.9 to 9.2 Mrays/s for
+ * ratios 1 to 3): flat up to about 1.5, falling beyond.  We take 1,
  * which also makes fewer references than larger ratios.  A step is cheap in
  * flops but often waits for a node from memory; a test is an indirect call
  * that cannot be inlined; both end in a hard-to-predict branch. */

@@ -32,9 +32,9 @@
  *             refracted ray (Snell)            colour += RayTrace(Refr)
  *
  * Its shading model is Heckbert's business card (minray.c) exactly, so
- * `./ray -o x.ppm scenes/minray.sph` prints minray's pixels.  Spheres and
- * triangles are the primitives; nearest_hit() asks the kd-tree (kdtree.c)
- * once a scene is large enough to gain from one.
+ * `./ray -o x.ppm scenes/minray.sph` prints minray's pixels.  Spheres, open
+ * cones and triangles are the primitives; nearest_hit() asks the kd-tree
+ * (kdtree.c) once a scene is large enough to gain from one.
  *
  * Build options: -DREAL=float makes every vector float instead of double
  * (the benchmark compares both); -fopenmp renders rows in parallel.  Output
