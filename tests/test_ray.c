@@ -554,17 +554,12 @@ static void test_camera(void)
 static int acne_at_scale(double k, int *counted)
 {
     Scene s;
-    Material m;
     Light *l;
     int i, j, wrong = 0, W = 96;
     Stats st;
     real v[10];
     memset(&st, 0, sizeof st);
-    memset(&m, 0, sizeof m);
-    m.color = v3(1, 1, 1);
-    m.kd = m.ir = 1;
-    default_scene(&s);
-    add_material(&s, m);
+    s = tri_scene(0);                   /* a scene with one white material */
     add_sphere(&s, v3(0, 0, -1e4 * k), 1e4 * k, 0);
     add_sphere(&s, v3(0, 0, k), k, 0);
     add_light(&s, v3(2 * k, -1 * k, 6 * k), v3(1, 1, 1), -1);
@@ -609,16 +604,11 @@ static int acne_at_scale(double k, int *counted)
 static int lone_acne(int cylinder, double k, double far, int *counted)
 {
     Scene s;
-    Material m;
     Stats st;
     real v[10];
     int i, j, wrong = 0, W = 64;
     memset(&st, 0, sizeof st);
-    memset(&m, 0, sizeof m);
-    m.color = v3(1, 1, 1);
-    m.kd = m.ir = 1;
-    default_scene(&s);
-    add_material(&s, m);
+    s = tri_scene(0);
     if (cylinder) add_cone(&s, v3(0, 0, -k), k, v3(0, 0, k), k, 0);
     else {
         int a = add_vertex(&s, v3(-k, 0, -k)), b = add_vertex(&s, v3(k, 0.3 * k, -k));
