@@ -691,11 +691,12 @@ long kd_splits(const kd_tree *t, int *axis, double *pos, long max)
  * that -0 counts as negative like its 1/d = -inf.  pad[a] is the margin
  * delta (see RAY_EPS) in units of t along axis a.  A denormal component can
  * make inv and pad infinite and the plane crossings NaN; every comparison
- * below is written so that NaN means "visit", which is always safe. */
+ * below is written so that NaN means "visit", which is always safe.  The
+ * origin is copied, not pointed to: the walk reads it at every step. */
 typedef struct {
-    const double *org, *dir;
-    double inv[3], pad[3];
-    int neg[3], flat[3];
+    double org[3], inv[3], pad[3];
+    uint32_t neg[3];
+    int flat[3];
     double delta;
     double t0, t1;  /* the part of the ray inside the (grown) scene box */
 } kd_ray;
@@ -706,45 +707,44 @@ typedef struct {
     double t0, t1;
 } kd_todo;
 
-static int finite3(const double v[3])
-{
-    return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
-}
-
-/* Clip the ray to one slab of the grown scene box.  A flat axis needs no
- * division: the ray is inside the slab for every t or for none. */
-static int clip_slab(const kd_tree *t, kd_ray *r, int a)
-{
-    double lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta, ta, tb;
-    if (r->flat[a]) return r->org[a] >= lo && r->org[a] <= hi;
-    ta = ((r->neg[a] ? hi : lo) - r->org[a]) * r->inv[a];
-    tb = ((r->neg[a] ? lo : hi) - r->org[a]) * r->inv[a];
-    if (ta > r->t0) r->t0 = ta;
-    if (tb < r->t1) r->t1 = tb;
-    return 1;
-}
-
-/* Set up the ray and clip it to the scene box (the slab test).  0 when it
- * misses the box, and for NaN or infinite input. */
+/* Set up the ray and clip it to the grown scene box (the slab test of Kay
+ * and Kajiya 1986).  0 when it misses the box, and for NaN or infinite
+ * input.  A flat axis needs no division: the ray is inside that slab for
+ * every t or for none.  Half the rays of a typical view miss the scene box
+ * and cost nothing else, so this is kept to one pass over the axes. */
 static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
                      double tmin, double tmax, kd_ray *r)
 {
-    double scale = t->scale;
+    double scale = t->scale, t0 = tmin, t1 = tmax;
     int a;
-    if (!finite3(org) || !finite3(dir)) return 0;
-    r->org = org, r->dir = dir, r->t0 = tmin, r->t1 = tmax;
     for (a = 0; a < 3; a++) {
-        r->neg[a] = copysign(1.0, dir[a]) < 0;
-        r->inv[a] = dir[a] != 0 ? 1.0 / dir[a] : r->neg[a] ? -HUGE_VAL : HUGE_VAL;
-        r->flat[a] = dir[a] == 0;
-        if (fabs(org[a]) > scale) scale = fabs(org[a]);
+        double m = fabs(org[a]);
+        if (!(m <= DBL_MAX) || !isfinite(dir[a])) return 0;
+        if (m > scale) scale = m;
     }
     r->delta = RAY_EPS * scale;
     for (a = 0; a < 3; a++) {
-        r->pad[a] = r->flat[a] ? 0 : r->delta * fabs(r->inv[a]);
-        if (!clip_slab(t, r, a)) return 0;
+        double o = org[a], d = dir[a], lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta;
+        double inv, ta, tb;
+        int neg = signbit(d) != 0;
+        r->org[a] = o;
+        r->neg[a] = (uint32_t)neg;
+        r->flat[a] = d == 0;
+        if (d == 0) {
+            r->inv[a] = neg ? -HUGE_VAL : HUGE_VAL;
+            r->pad[a] = 0;
+            if (!(o >= lo && o <= hi)) return 0;
+            continue;
+        }
+        r->inv[a] = inv = 1.0 / d;
+        r->pad[a] = r->delta * fabs(inv);
+        ta = ((neg ? hi : lo) - o) * inv;
+        tb = ((neg ? lo : hi) - o) * inv;
+        if (ta > t0) t0 = ta;
+        if (tb < t1) t1 = tb;
     }
-    return r->t0 <= r->t1;  /* false for NaN in tmin or tmax */
+    r->t0 = t0, r->t1 = t1;
+    return t0 <= t1;  /* false for NaN in tmin or tmax */
 }
 
 static void push(kd_todo *stack, int *n, uint32_t node, double t0, double t1)
@@ -787,7 +787,7 @@ static uint32_t step(const kd_node *nd, const kd_ray *r, double *t0,
  * would; the callback gets tmax = the best t so far, inclusive, so that it
  * reports such ties.  Any-hit: the first hit will do. */
 static int test_leaf(const kd_tree *t, const kd_node *nd, const kd_prims *p,
-                     const void *ray, double tmin, int any, double *best_t,
+                     void *ray, double tmin, int any, double *best_t,
                      int best, unsigned long long *tests)
 {
     const int *list = t->prims + node_index(nd);
@@ -824,7 +824,7 @@ static long pop(const kd_todo *stack, int *n, double best_t)
 
 /* The walk shared by kd_nearest (any = 0) and kd_any (any = 1). */
 static int walk(const kd_tree *t, const kd_prims *p, const kd_ray *r,
-                const void *ray, double tmin, int any, double *best_t,
+                void *ray, double tmin, int any, double *best_t,
                 kd_counters *c)
 {
     kd_todo stack[STACK_SIZE];
@@ -851,7 +851,7 @@ static int walk(const kd_tree *t, const kd_prims *p, const kd_ray *r,
 }
 
 int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
-               const double dir[3], const void *ray, double tmin,
+               const double dir[3], void *ray, double tmin,
                double *tmax, kd_counters *c)
 {
     kd_ray r;
@@ -865,7 +865,7 @@ int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
 }
 
 int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
-           const double dir[3], const void *ray, double tmin, double tmax,
+           const double dir[3], void *ray, double tmin, double tmax,
            kd_counters *c)
 {
     kd_ray r;

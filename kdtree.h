@@ -29,11 +29,13 @@ typedef struct {
                 double lo[3], double hi[3]);
     /* Intersect primitive i with the caller's ray (passed through untouched
      * as `ray`).  Returns 1 and sets *t when it hits at tmin < *t <= tmax.
+     * `ray` is not const: the callback may note things there, such as where
+     * on the primitive its last hit lay, to spare the caller a second test.
      * The tree finds exactly what a loop over all primitives finds as long
      * as the point org + t*dir of a reported hit lies in the primitive's box
      * (its clipped box, with clip), give or take a margin of 1e-9 times the
      * largest coordinate of the scene and the ray origin. */
-    int (*hit)(void *user, int i, const void *ray, double tmin, double tmax,
+    int (*hit)(void *user, int i, void *ray, double tmin, double tmax,
                double *t);
     void *user;
 } kd_prims;
@@ -62,12 +64,12 @@ kd_tree *kd_build(int n, const kd_prims *p);
  * primitive (ties in t go to the lower index, as a brute-force loop would)
  * and stores its t in *tmax; returns -1 and leaves *tmax alone on a miss. */
 int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
-               const double dir[3], const void *ray, double tmin,
+               const double dir[3], void *ray, double tmin,
                double *tmax, kd_counters *c);
 
 /* 1 when any primitive is hit with tmin < t <= tmax: for shadow rays. */
 int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
-           const double dir[3], const void *ray, double tmin, double tmax,
+           const double dir[3], void *ray, double tmin, double tmax,
            kd_counters *c);
 
 void kd_describe(const kd_tree *t, kd_info *info);

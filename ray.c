@@ -124,8 +124,12 @@ typedef struct { vec cen; real rad; int mat; } Sphere;
 typedef struct { vec base, axis; real len, rb, ra; int mat; } Cone;
 
 /* Vertices and normals are indices into the scene's shared arrays, so two
- * triangles that share an edge share its exact coordinates. */
+ * triangles that share an edge share its exact coordinates.  The hit test
+ * needs the first vertex and the two edges from it; they are kept here too,
+ * computed once, so that a test reads one record instead of three vertices
+ * scattered through memory (same values, so the same answers). */
 typedef struct {
+    vec v0, e1, e2;      /* vert[v[0]], vert[v[1]] - v0, vert[v[2]] - v0 */
     int v[3], n[3];      /* n[0] < 0: no vertex normals, shade flat */
     int mat;
     char cull;           /* 1: one-sided, hit from the front only */
@@ -336,8 +340,7 @@ static int watertight_inside(vec a, vec b, vec c, const Ray *r)
 static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
                         real *t, real *u, real *v)
 {
-    vec v0 = s->vert[tr->v[0]], v1 = s->vert[tr->v[1]], v2 = s->vert[tr->v[2]];
-    vec e1 = sub(v1, v0), e2 = sub(v2, v0), p = cross(r->d, e2), tv, q;
+    vec v0 = tr->v0, e1 = tr->e1, e2 = tr->e2, p = cross(r->d, e2), tv, q;
     real det = dot(e1, p), sign = det < 0 ? -1 : 1, slack, uu, vv, tt;
     if (tr->degenerate || isnan(det)) return 0;
     if (tr->cull) {                      /* the lecture's culling branch */
@@ -354,7 +357,8 @@ static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real t
     if (vv < -slack || uu + vv > det + slack) return 0;
     tt = sign * dot(e2, q);
     if (!(tt > 0)) return 0;             /* behind the origin, or NaN */
-    if ((uu < 0 || vv < 0 || uu + vv > det) && !watertight_inside(v0, v1, v2, r)) return 0;
+    if ((uu < 0 || vv < 0 || uu + vv > det)
+        && !watertight_inside(v0, s->vert[tr->v[1]], s->vert[tr->v[2]], r)) return 0;
     *t = tt / det;      /* compared after the division: a tie at tmax must be exact */
     if (!(*t <= tmax)) return 0;
     *u = uu / det;
@@ -387,8 +391,21 @@ static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
     return *t <= tmax && *t < INFINITY;         /* INFINITY is a miss */
 }
 
-/* The point, normals and material of the hit on object i at t. */
-static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
+/* What the tree hands its hit callback for one query: the ray, and where
+ * on it the last triangle reported was hit, so that nearest_hit need not
+ * intersect the nearest triangle a second time to shade it. */
+typedef struct { Ray r; int obj; real t, u, v; } Query;
+
+static Query query(Ray r)
+{
+    Query q;
+    q.r = r, q.obj = -1;
+    return q;
+}
+
+/* The point, normals and material of the hit on object i at t.  q (or
+ * NULL) may hold the barycentrics of that hit already. */
+static void surface(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h)
 {
     int k, what = kind(s, i, &k);
     h->t = t;
@@ -409,11 +426,12 @@ static void surface(const Scene *s, Ray r, int i, real t, Hit *h)
         const Triangle *tr = &s->tri[k];
         vec a = s->vert[tr->v[0]], b = s->vert[tr->v[1]], c = s->vert[tr->v[2]];
         real u, v, tt;
-        hit_triangle(s, tr, &r, INFINITY, &tt, &u, &v);
+        if (q && q->obj == i && q->t == t) u = q->u, v = q->v;
+        else hit_triangle(s, tr, &r, INFINITY, &tt, &u, &v);
         /* from the barycentrics, not o + t d: exact to the triangle's own
          * rounding, however far away the ray came from */
         h->p = add(add(scale(1 - u - v, a), scale(u, b)), scale(v, c));
-        h->ng = unit(cross(sub(b, a), sub(c, a)));
+        h->ng = unit(cross(tr->e1, tr->e2));
         h->n = h->ng;
         if (tr->n[0] >= 0) {
             vec n = add(add(scale(1 - u - v, s->norm[tr->n[0]]), scale(u, s->norm[tr->n[1]])),
@@ -476,6 +494,35 @@ static void kd_bounds(void *user, int i, double lo[3], double hi[3])
     }
 }
 
+/* The box of the part of a sphere inside [blo, bhi].  Cutting the sphere's
+ * own box to the cell would leave the cell's corners in it, and a sphere
+ * fills only half its box: in a scene of many spheres (SPD balls) a ray
+ * would test, in every cell a sphere's box reaches, a sphere it cannot hit
+ * there.  A point of the sphere that lies in the cell is at least db and dc
+ * from the centre along the other two axes (0 when the centre is level with
+ * the cell), so along axis a it is within sqrt(r^2 - db^2 - dc^2) of the
+ * centre.  That square root is taken of a difference which can cancel, so
+ * 1e-12 r^2 is added under it: far above the rounding error, and the box
+ * grows by at most 1e-6 r. */
+static int clip_sphere(const Sphere *sp, const double blo[3], const double bhi[3],
+                       double lo[3], double hi[3])
+{
+    double c[3], d[3], r2 = (double)sp->rad * sp->rad, slack = 1e-12 * r2;
+    int a;
+    to3(sp->cen, c);
+    for (a = 0; a < 3; a++)
+        d[a] = c[a] < blo[a] ? blo[a] - c[a] : c[a] > bhi[a] ? c[a] - bhi[a] : 0;
+    for (a = 0; a < 3; a++) {
+        double db = d[(a + 1) % 3], dc = d[(a + 2) % 3], e2 = r2 - db * db - dc * dc, e;
+        if (!(e2 >= -slack)) return 0;
+        e = fmin(sqrt(fmax(e2, 0) + slack), sp->rad);
+        lo[a] = fmax(c[a] - e, blo[a]);
+        hi[a] = fmin(c[a] + e, bhi[a]);
+        if (!(lo[a] <= hi[a])) return 0;
+    }
+    return 1;
+}
+
 /* The box of the part of a triangle inside [blo, bhi]: the triangle clipped
  * by the box's six planes (Sutherland and Hodgman, 1974), so that the tree
  * can split a long triangle exactly ("perfect splits", Havran 2000).  A
@@ -486,6 +533,7 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
     const Scene *s = user;
     double poly[2][9][3];
     int n = 3, k, a, side, cur = 0, tri;
+    if (kind(s, i, &tri) == SPHERE) return clip_sphere(&s->sph[tri], blo, bhi, lo, hi);
     kd_bounds(user, i, lo, hi);
     if (kind(s, i, &tri) != TRIANGLE) {
         for (a = 0; a < 3; a++) {
@@ -530,11 +578,18 @@ static int kd_clip(void *user, int i, const double blo[3], const double bhi[3],
     return 1;
 }
 
-static int kd_hit(void *user, int i, const void *ray, double tmin, double tmax, double *t)
+static int kd_hit(void *user, int i, void *ray, double tmin, double tmax, double *t)
 {
-    real tt;
+    const Scene *s = user;
+    Query *q = ray;
+    real tt, u, v;
+    int k;
     (void)tmin;             /* rays start off the surface; see spawn() */
-    if (!hit_object(user, i, ray, (real)tmax, &tt)) return 0;
+    if (kind(s, i, &k) == TRIANGLE) {
+        if (!hit_triangle(s, &s->tri[k], &q->r, (real)tmax, &tt, &u, &v)) return 0;
+        q->obj = i, q->t = tt, q->u = u, q->v = v;
+    } else if (!hit_object(s, i, &q->r, (real)tmax, &tt))
+        return 0;
     *t = tt;
     return 1;
 }
@@ -552,6 +607,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
 {
     real t = INFINITY, ti;
     int i, best = -1;
+    Query q = query(r);
     st->queries++;
     st->nearest++;
     if (s->tree) {
@@ -559,7 +615,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
         kd_counters c = { 0, 0, 0 };
         to3(r.o, o);
         to3(r.d, d);
-        best = kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, &c);
+        best = kd_nearest(s->tree, &s->prims, o, d, &q, 0, &tmax, &c);
         t = (real)tmax;
         st->steps += c.steps;
         st->tests += c.tests;
@@ -570,7 +626,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
     }
     if (best < 0) return 0;
     st->hits++;
-    surface(s, r, best, t, h);
+    surface(s, r, best, t, &q, h);
     return 1;
 }
 
@@ -585,9 +641,10 @@ static int any_hit(const Scene *s, Ray r, real tmax, Stats *st)
         double o[3], d[3];
         kd_counters c = { 0, 0, 0 };
         int hit;
+        Query q = query(r);
         to3(r.o, o);
         to3(r.d, d);
-        hit = kd_any(s->tree, &s->prims, o, d, &r, 0, tmax, &c);
+        hit = kd_any(s->tree, &s->prims, o, d, &q, 0, tmax, &c);
         st->steps += c.steps;
         st->tests += c.tests;
         return hit;
@@ -941,6 +998,9 @@ static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, 
     s->tri = grow(s->tri, &s->captri, s->ntri + 1, sizeof *s->tri);
     tr = &s->tri[s->ntri++];
     tr->v[0] = a; tr->v[1] = b; tr->v[2] = c;
+    tr->v0 = s->vert[a];
+    tr->e1 = sub(s->vert[b], s->vert[a]);
+    tr->e2 = sub(s->vert[c], s->vert[a]);
     if (na < 0 || nb < 0 || nc < 0) na = nb = nc = -1;
     tr->n[0] = na; tr->n[1] = nb; tr->n[2] = nc;
     tr->mat = mat;

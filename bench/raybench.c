@@ -313,7 +313,8 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
             double o[3], d[3], tmax = INFINITY;
             o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
             d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
-            obj[i] = kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, NULL);
+            Query q = query(r);
+            obj[i] = kd_nearest(s->tree, &s->prims, o, d, &q, 0, &tmax, NULL);
             t[i] = tmax;
         } else {
             Hit h;
@@ -375,13 +376,13 @@ static void rb_compare(const Scene *s, const char *set, const RbRay *rays, long 
  * (kdtree.c keeps no "mailbox"); the repeats say what one would save.  The
  * tree's own hit callback is wrapped, so nothing in ray.c changes. */
 static struct {
-    int (*hit)(void *, int, const void *, double, double, double *);
+    int (*hit)(void *, int, void *, double, double, double *);
     unsigned long *mark;      /* per primitive: the last ray that tested it */
     unsigned long ray;
     unsigned long long tests, repeats;
 } rb_probe;
 
-static int rb_counting_hit(void *user, int i, const void *ray, double tmin, double tmax, double *t)
+static int rb_counting_hit(void *user, int i, void *ray, double tmin, double tmax, double *t)
 {
     rb_probe.tests++;
     if (rb_probe.mark[i] == rb_probe.ray) rb_probe.repeats++;
@@ -400,13 +401,15 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
     s->prims.hit = rb_counting_hit;
     for (i = 0; i < n; i++) {
         double o[3], d[3], tmax = INFINITY;
+        Query q;
         Ray r;
         int k;
         for (k = 0; k < 3; k++) o[k] = rays[i].o[k], d[k] = rays[i].d[k];
         r.o = v3(o[0], o[1], o[2]);
         r.d = v3(d[0], d[1], d[2]);
+        q = query(r);
         rb_probe.ray = (unsigned long)i + 1;
-        kd_nearest(s->tree, &s->prims, o, d, &r, 0, &tmax, &c);
+        kd_nearest(s->tree, &s->prims, o, d, &q, 0, &tmax, &c);
     }
     s->prims.hit = rb_probe.hit;
     free(rb_probe.mark);

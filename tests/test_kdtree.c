@@ -166,7 +166,7 @@ static int hit_sphere(const prim *s, const ray *r, double tmin, double tmax,
     return 1;
 }
 
-static int hit(void *user, int i, const void *rv, double tmin, double tmax,
+static int hit(void *user, int i, void *rv, double tmin, double tmax,
                double *t)
 {
     const prim *p = &((const scene *)user)->p[i];

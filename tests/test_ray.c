@@ -296,6 +296,55 @@ static void test_watertight(int shared)
     free_scene(&s);
 }
 
+/* clip_sphere gives the tree the box of the part of a sphere inside a
+ * cell.  Every point of the sphere that lies in the cell must lie in that
+ * box (else the tree could miss a hit there), and the box must be tighter
+ * than the sphere's own box cut to the cell (else it is no use).  Points:
+ * 2000 on each of 2000 random spheres, cells random boxes across them. */
+static void test_clip_sphere(void)
+{
+    unsigned long long x = 7;
+    long outside = 0, inside = 0, cells = 0;
+    double gain = 0;
+    int k, j, a;
+    for (k = 0; k < 2000; k++) {
+        double scale = pow(10, 8 * rnd(&x) - 4);
+        Sphere sp = sphere(scale * (rnd(&x) - 0.5), scale * (rnd(&x) - 0.5), scale * (rnd(&x) - 0.5),
+                           scale * (0.01 + rnd(&x)));
+        double blo[3], bhi[3], lo[3], hi[3], c[3], vol_clip = 1, vol_cut = 1;
+        to3(sp.cen, c);
+        for (a = 0; a < 3; a++) {
+            double p = c[a] + sp.rad * (3 * rnd(&x) - 1.5), q = c[a] + sp.rad * (3 * rnd(&x) - 1.5);
+            blo[a] = fmin(p, q), bhi[a] = fmax(p, q);
+        }
+        if (!clip_sphere(&sp, blo, bhi, lo, hi)) lo[0] = hi[0] = NAN;   /* "nothing inside" */
+        else {
+            cells++;
+            for (a = 0; a < 3; a++) {
+                vol_clip *= hi[a] - lo[a];
+                vol_cut *= fmin(bhi[a], c[a] + sp.rad) - fmax(blo[a], c[a] - sp.rad);
+            }
+            if (vol_cut > 0) gain += vol_clip / vol_cut;
+        }
+        for (j = 0; j < 2000; j++) {
+            /* a uniform point on the sphere (Marsaglia's cylinder method) */
+            double z = 2 * rnd(&x) - 1, phi = 2 * PI * rnd(&x), s = sqrt(1 - z * z), p[3];
+            int in_cell = 1, in_box = 1;
+            p[0] = c[0] + sp.rad * s * cos(phi), p[1] = c[1] + sp.rad * s * sin(phi), p[2] = c[2] + sp.rad * z;
+            for (a = 0; a < 3; a++) {
+                in_cell &= p[a] >= blo[a] && p[a] <= bhi[a];
+                in_box &= p[a] >= lo[a] && p[a] <= hi[a];
+            }
+            inside += in_cell;
+            outside += in_cell && !in_box;
+        }
+    }
+    report(outside == 0 && inside > 100000, "sphere clipped to a cell: every point of it in the cell is in the box",
+           "%g of %g points outside", (double)outside, (double)inside);
+    report(cells > 0 && gain / cells < 0.9, "sphere clipped to a cell: tighter than the cut box",
+           "mean volume ratio %.3f over %g cells", gain / cells, (double)cells);
+}
+
 /* The kd-tree must give what the loop gives: same object, same t, bit for
  * bit, for a scene of spheres and triangles and rays of every awkward kind. */
 static void test_tree_matches_loop(void)
@@ -680,6 +729,7 @@ int main(void)
     test_obj();
     test_watertight(1);
     test_watertight(0);
+    test_clip_sphere();
     test_tree_matches_loop();
     test_acne();
     return failures != 0;
