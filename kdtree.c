@@ -29,23 +29,26 @@
  * through a child is the ratio of their areas.  COST_STEP is one traversal
  * step, COST_TEST one call of the hit callback; only their ratio shapes the
  * tree, a larger COST_TEST giving deeper trees with fewer primitives per
- * leaf and more references.  The ratio was measured, not guessed: on a
- * 100k-triangle sphere (a test program since folded into bench/raybench.c),
- * ratios 0.75, 1, 1.25, 1.5, 2, 3 gave 4.3, 4.2, 4.1, 4.2, 3.9, 3.8 Mrays/s
- * (5.2, 5.2, 5.1, 5.0, 4.9, 4.7 with perfect splits), and ray.c's own
- * triangles later gave the same flat picture (8.9 to 9.2 Mrays/s for
- * ratios 1 to 3): flat up to about 1.5, falling beyond.  We take 1,
- * which also makes fewer references than larger ratios.  A step is cheap in
- * flops but often waits for a node from memory; a test is an indirect call
- * that cannot be inlined; both end in a hard-to-predict branch. */
+ * leaf and more references.  The ratio was measured, not guessed.  On a
+ * 100k-triangle sphere, primary rays, ratios 0.75 to 3 all gave within 5%
+ * of the same speed, falling beyond 1.5.  Whole renders of the SPD scenes
+ * (one thread, 256x256 or 512x512, best of 5) then chose between 1 and
+ * 0.6: with 0.6 (and EMPTY_BONUS 0.9 below) balls took 6% less time,
+ * mount 7% and rings 5% less, gears 5% more, the others and the sphere the
+ * same within 1%.  Walking cells costs more than the model says: each step
+ * ends in a branch that goes either way (near, far or both), and the
+ * processor guesses it wrong about half the time, while a test of a few
+ * primitives in a row runs at full speed.  Fewer, fuller leaves pay.
+ * The smaller ratio also makes fewer references and builds faster. */
 #define COST_STEP 1.0
-#define COST_TEST 1.0
+#define COST_TEST 0.6
 
 /* Cutting off empty space pays more than the model says: a ray that enters
  * an empty cell leaves it at once, and it shrinks the cells that do hold
- * primitives.  Wald & Havran 2006 scale the cost of such splits by 0.8;
- * so do we. */
-#define EMPTY_BONUS 0.8
+ * primitives.  Wald & Havran 2006 scale the cost of such splits by 0.8.
+ * We take 0.9, measured with COST_TEST above on SPD balls: 0.8 was 3%
+ * slower, 1.0 the same, 0.6 7% slower. */
+#define EMPTY_BONUS 0.9
 
 /* Hard limit on depth, so the traversal stack can be a fixed array.  The
  * build stops at 8 + 1.3 log2 N (below), which stays under this for any N
