@@ -166,12 +166,20 @@ static int hit_sphere(const prim *s, const ray *r, double tmin, double tmax,
     return 1;
 }
 
+static int test_prim(const scene *s, int i, const ray *r, double tmin, double tmax,
+                     double *t)
+{
+    const prim *p = &s->p[i];
+    return p->kind == TRI ? hit_tri(p, r, tmin, tmax, t)
+                          : hit_sphere(p, r, tmin, tmax, t);
+}
+
+/* The tree's hit callback (its ray argument is not const: a caller may
+ * keep notes there; this one does not). */
 static int hit(void *user, int i, void *rv, double tmin, double tmax,
                double *t)
 {
-    const prim *p = &((const scene *)user)->p[i];
-    return p->kind == TRI ? hit_tri(p, rv, tmin, tmax, t)
-                          : hit_sphere(p, rv, tmin, tmax, t);
+    return test_prim(user, i, rv, tmin, tmax, t);
 }
 
 static void bounds(void *user, int i, double lo[3], double hi[3])
@@ -585,7 +593,7 @@ static int brute_nearest(const scene *s, const ray *r, double tmin, double *tmax
     double best_t = *tmax, t;
     int i, best = -1;
     for (i = 0; i < s->n; i++)
-        if (hit((void *)s, i, r, tmin, best_t, &t)
+        if (test_prim(s, i, r, tmin, best_t, &t)
             && (t < best_t || (t == best_t && (best < 0 || i < best))))
             best_t = t, best = i;
     if (best >= 0) *tmax = best_t;
@@ -597,7 +605,7 @@ static int brute_any(const scene *s, const ray *r, double tmin, double tmax)
     double t;
     int i;
     for (i = 0; i < s->n; i++)
-        if (hit((void *)s, i, r, tmin, tmax, &t)) return 1;
+        if (test_prim(s, i, r, tmin, tmax, &t)) return 1;
     return 0;
 }
 
@@ -610,7 +618,7 @@ static int reference_nearest(const scene *s, const ray *r, double tmin,
     double t;
     if (strcmp(s->name, "same") || k % 1000 == 0)
         return brute_nearest(s, r, tmin, tmax);
-    if (!hit((void *)s, 0, r, tmin, *tmax, &t)) return -1;
+    if (!test_prim(s, 0, r, tmin, *tmax, &t)) return -1;
     *tmax = t;
     return 0;
 }
@@ -620,7 +628,7 @@ static int reference_any(const scene *s, const ray *r, double tmin,
 {
     double t;
     if (strcmp(s->name, "same") || k % 1000 == 0) return brute_any(s, r, tmin, tmax);
-    return hit((void *)s, 0, r, tmin, tmax, &t);
+    return test_prim(s, 0, r, tmin, tmax, &t);
 }
 
 /* ---- checks ---------------------------------------------------------- */
