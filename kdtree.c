@@ -32,7 +32,8 @@
  * leaf and more references.  The ratio was measured, not guessed.  On a
  * 100k-triangle sphere, primary rays, ratios 0.75 to 3 all gave within 5%
  * of the same speed, falling beyond 1.5.  Whole renders of the SPD scenes
- * (one thread, 256x256 or 512x512, best of 5) then chose between 1 and
+ * (one thread; balls at 512x512, best of 5; the others at 256x256, best
+ * of 3) then chose between 1 and
  * 0.6: with 0.6 (and EMPTY_BONUS 0.9 below) balls took 6% less time,
  * mount 7% and rings 5% less, gears 5% more, the others and the sphere the
  * same within 1%.  Walking cells costs more than the model says: each step
