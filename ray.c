@@ -178,7 +178,11 @@ static int kind(const Scene *s, int i, int *k)
     return TRIANGLE;
 }
 
-typedef struct { vec o, d; } Ray;
+/* A ray: origin o, direction d, and skip, an object it cannot hit (or -1).
+ * A ray leaving a flat triangle, or a sphere outward, never meets that
+ * surface again, yet it starts in the tree's cells that list it; skipping
+ * the test saves one test in five on the SPD balls scene, 9% of its time. */
+typedef struct { vec o, d; int skip; } Ray;
 
 typedef struct {
     real t;
@@ -206,16 +210,19 @@ typedef struct {
  * the point of the line closest to it, which has no such cancellation; and
  * the two roots come from q and c/q so that neither subtracts two nearly
  * equal numbers (Haines, Guenter, Jones, Akenine-Moller and Hunt, "Precision
- * Improvements for Ray/Sphere Intersection", Ray Tracing Gems, ch. 7, 2019). */
+ * Improvements for Ray/Sphere Intersection", Ray Tracing Gems, ch. 7, 2019).
+ * l is kept multiplied by a = d.d, so that a miss, the common case in a
+ * tree's leaf, costs no division (2% on the SPD balls scene). */
 static real hit_sphere(const Sphere *sp, const Ray *r, real tmin)
 {
     vec f = sub(r->o, sp->cen);
     real a = dot(r->d, r->d);
     real b = -dot(f, r->d);                      /* half of -B in a t^2 + B t + C */
-    vec l = add(f, scale(b / a, r->d));
-    real disc = a * (sp->rad * sp->rad - dot(l, l));
+    vec l = comb(b, r->d, scale(a, f));          /* a l */
+    real ar = a * sp->rad, disc = ar * ar - dot(l, l);   /* a^2 (r^2 - l.l) */
     real c, q, t0, t1;
     if (!(disc >= 0)) return INFINITY;          /* also rejects NaN */
+    disc /= a;                                  /* the quarter discriminant */
     c = dot(f, f) - sp->rad * sp->rad;
     q = b + (b >= 0 ? sqrt(disc) : -sqrt(disc));
     t0 = c / q;
@@ -384,6 +391,7 @@ static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
 {
     real u, v;
     int k;
+    if (i == r->skip) return 0;
     switch (kind(s, i, &k)) {
     case SPHERE: *t = hit_sphere(&s->sph[k], r, 0); break;
     case CONE: *t = hit_cone(&s->cone[k], r, 0); break;
@@ -586,6 +594,7 @@ static int kd_hit(void *user, int i, void *ray, double tmin, double tmax, double
     real tt, u, v;
     int k;
     (void)tmin;             /* rays start off the surface; see spawn() */
+    if (i == q->r.skip) return 0;
     if (kind(s, i, &k) == TRIANGLE) {
         if (!hit_triangle(s, &s->tri[k], &q->r, (real)tmax, &tt, &u, &v)) return 0;
         q->obj = i, q->t = tt, q->u = u, q->v = v;
@@ -665,12 +674,14 @@ static int any_hit(const Scene *s, Ray r, real tmax, Stats *st)
  * whatever the scene's units (Pharr, Jakob and Humphreys, pbrt 3rd ed.,
  * sect. 3.9.5, "Robust spawned ray origins").  The 64 covers the dozen or so
  * roundings between the ray, the root and the point, with margin. */
-static Ray spawn(const Hit *h, vec dir)
+static Ray spawn(const Scene *s, const Hit *h, vec dir)
 {
     real eps = 64 * REAL_EPS * h->size;
+    int k, out = dot(dir, h->ng) >= 0, what = kind(s, h->obj, &k);
     Ray r;
-    r.o = comb(dot(dir, h->ng) >= 0 ? eps : -eps, h->ng, h->p);
+    r.o = comb(out ? eps : -eps, h->ng, h->p);
     r.d = dir;
+    r.skip = what == TRIANGLE || (what == SPHERE && out) ? h->obj : -1;
     return r;
 }
 
@@ -686,7 +697,7 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
     *e = k * dot(n, dir);
     if (!(*e > 0)) return 0;    /* facing away: no ray, as the SPD rules say */
     st->shadow++;
-    r = spawn(h, dir);
+    r = spawn(s, h, dir);
     if (l->sphere < 0)          /* a point light: anything before it blocks */
         return !any_hit(s, r, sqrt(dot(sub(l->pos, r.o), sub(l->pos, r.o))), st);
     return nearest_hit(s, r, &blocker, st) && blocker.obj == l->sphere;
@@ -749,11 +760,11 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, St
     if (worth_tracing(m->ks, weight, depth)) {
         st->reflected++;
         vec mirror = reflect(r.d, n, cosi);
-        c = comb(m->ks, trace(s, spawn(h, mirror), depth - 1, m->ks * weight, st), c);
+        c = comb(m->ks, trace(s, spawn(s, h, mirror), depth - 1, m->ks * weight, st), c);
     }
     if (worth_tracing(m->kt, weight, depth) && refract(r.d, n, cosi, eta, &t)) {
         st->refracted++;
-        c = comb(m->kt, trace(s, spawn(h, t), depth - 1, m->kt * weight, st), c);
+        c = comb(m->kt, trace(s, spawn(s, h, t), depth - 1, m->kt * weight, st), c);
     }
     return c;
 }
@@ -779,6 +790,7 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
     real dist = (real)w / 2 / c->tan_half;
     Ray r;
     r.o = c->eye;
+    r.skip = -1;
     r.d = unit(add(add(scale(x - (real)w / 2, c->right),
                        scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
     return r;
