@@ -33,7 +33,7 @@ typedef struct {
      * on the primitive its last hit lay, to spare the caller a second test.
      * The tree finds exactly what a loop over all primitives finds as long
      * as the point org + t*dir of a reported hit lies in the primitive's box
-     * (its clipped box, with clip), give or take a margin of 1e-9 times the
+     * (its clipped box, with clip), give or take a margin of 1e-7 times the
      * largest coordinate of the scene and the ray origin. */
     int (*hit)(void *user, int i, void *ray, double tmin, double tmax,
                double *t);

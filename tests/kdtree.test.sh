@@ -20,7 +20,7 @@ fi
 if [ -n "$KD_QUICK" ]; then export KD_RAYS=${KD_RAYS:-100000}; fi
 
 # The scenes run side by side; their lines are printed in a fixed order.
-scenes="same mesh grid soup flat empty one"
+scenes="same mesh grid thirds soup flat empty one"
 for s in $scenes; do
   ( "$TMP/test_kdtree" "$s" >"$TMP/$s.out" 2>"$TMP/$s.err"; echo $? >"$TMP/$s.rc" ) &
 done

@@ -12,7 +12,7 @@ count() { while read -r line; do echo "$line"; case $line in PASS*) pass=$((pass
 $CC $CFLAGS -o "$TMP/test_kdtree" tests/test_kdtree.c kdtree.c -lm || exit 2
 mkdir -p "$TMP/kd"
 for seed in 11 12; do
-  for s in same mesh grid soup flat; do     # two at a time, one per core
+  for s in same mesh grid thirds soup flat; do     # two at a time, one per core
     KD_RAYS=2000000 KD_SCALE=4 KD_SEED=$seed "$TMP/test_kdtree" "$s" > "$TMP/kd/$seed.$s" 2>/dev/null &
     [ "$(jobs -r | wc -l)" -ge 2 ] && wait -n
   done

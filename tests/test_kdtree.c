@@ -2,7 +2,7 @@
  *
  *     test_kdtree SCENE [RAYS]
  *
- * SCENE is one of: soup mesh grid same flat empty one.  Prints one line per
+ * SCENE is one of: soup mesh grid thirds same flat empty one.  Prints one line per
  * check, "PASS ..." or "FAIL ...", and exits 1 if any check failed.  RAYS
  * (default 1000000, or $KD_RAYS) rays are shot per scene; each must give the
  * same primitive and bitwise the same t as the loop
@@ -324,10 +324,12 @@ static void make_mesh(scene *s)
     s->n = k, s->use_clip = 0, s->grid = 1.0 / 256, s->small_dirs = 0;
 }
 
-/* Axis-aligned rectangles on an integer lattice in [0,6]^3, two triangles
- * each, some of them repeated: splits fall on lattice planes, rays along
- * lattice lines run along edges and through corners. */
-static void make_grid(scene *s)
+/* Axis-aligned rectangles on a lattice of the given step in [0,6 step]^3,
+ * two triangles each, some of them repeated: splits fall on lattice planes,
+ * rays along lattice lines run along edges and through corners.  With step
+ * 1 every coordinate is a float; with step 1/3 ("thirds") most are not, and
+ * the tree's float planes and boxes round them (see kd_box in kdtree.c). */
+static void make_grid(scene *s, double step)
 {
     int q, nq = (int)(120 * scale), k = 0;
     s->p = alloc_prims(2 * nq);
@@ -342,15 +344,15 @@ static void make_grid(scene *s)
             continue;
         }
         c = irand(7);
-        v[0][ax] = v[1][ax] = v[2][ax] = v[3][ax] = c;
-        v[0][u] = u0, v[0][w] = w0;
-        v[1][u] = u0 + du, v[1][w] = w0;
-        v[2][u] = u0 + du, v[2][w] = w0 + dw;
-        v[3][u] = u0, v[3][w] = w0 + dw;
+        v[0][ax] = v[1][ax] = v[2][ax] = v[3][ax] = c * step;
+        v[0][u] = u0 * step, v[0][w] = w0 * step;
+        v[1][u] = (u0 + du) * step, v[1][w] = w0 * step;
+        v[2][u] = (u0 + du) * step, v[2][w] = (w0 + dw) * step;
+        v[3][u] = u0 * step, v[3][w] = (w0 + dw) * step;
         s->p[k++] = make_tri(v[0], v[1], v[2]);
         s->p[k++] = make_tri(v[0], v[2], v[3]);
     }
-    s->n = k, s->use_clip = 1, s->grid = 0.5, s->small_dirs = 1;
+    s->n = k, s->use_clip = 1, s->grid = step / 2, s->small_dirs = 1;
 }
 
 /* 10,000 copies of one triangle: one leaf, every hit a 10,000-way tie. */
@@ -394,7 +396,8 @@ static int make_scene(const char *name, scene *s)
     s->name = name;
     if (!strcmp(name, "soup")) make_soup(s);
     else if (!strcmp(name, "mesh")) make_mesh(s);
-    else if (!strcmp(name, "grid")) make_grid(s);
+    else if (!strcmp(name, "grid")) make_grid(s, 1);
+    else if (!strcmp(name, "thirds")) make_grid(s, 1.0 / 3);
     else if (!strcmp(name, "same")) make_same(s);
     else if (!strcmp(name, "flat")) make_flat(s);
     else if (!strcmp(name, "one")) make_one(s);
@@ -779,7 +782,7 @@ int main(int argc, char **argv)
     if (!(scale >= 0.1)) scale = 0.1;
     if (argc > 2) nrays = atol(argv[2]);
     if (argc < 2 || !make_scene(argv[1], &s)) {
-        fprintf(stderr, "usage: test_kdtree soup|mesh|grid|same|flat|empty|one [rays]\n");
+        fprintf(stderr, "usage: test_kdtree soup|mesh|grid|thirds|same|flat|empty|one [rays]\n");
         return 2;
     }
     p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s;
