@@ -594,9 +594,9 @@ static int kd_hit(void *user, int i, void *ray, double tmin, double tmax, double
     real tt, u, v;
     int k;
     (void)tmin;             /* rays start off the surface; see spawn() */
-    if (i == q->r.skip) return 0;
-    if (kind(s, i, &k) == TRIANGLE) {
-        if (!hit_triangle(s, &s->tri[k], &q->r, (real)tmax, &tt, &u, &v)) return 0;
+    if (kind(s, i, &k) == TRIANGLE) {   /* hit_object would test it again */
+        if (i == q->r.skip || !hit_triangle(s, &s->tri[k], &q->r, (real)tmax, &tt, &u, &v))
+            return 0;
         q->obj = i, q->t = tt, q->u = u, q->v = v;
     } else if (!hit_object(s, i, &q->r, (real)tmax, &tt))
         return 0;
