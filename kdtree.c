@@ -727,12 +727,27 @@ long kd_splits(const kd_tree *t, int *axis, double *pos, long max)
  * make inv and pad infinite and the plane crossings NaN; every comparison
  * below is written so that NaN means "visit", which is always safe.  The
  * origin is copied, not pointed to: the walk reads it at every step. */
+/* A primitive listed in several cells (one that straddles a plane) would be
+ * tested again in each cell the ray visits, yet the answer cannot change: a
+ * miss stays a miss under a smaller tmax, and a hit lies at or beyond the
+ * best t found since.  So each ray keeps a mailbox (Amanatides & Woo 1987,
+ * "A fast voxel traversal algorithm for ray tracing"): here the last
+ * primitive tested in each of MAILBOX slots chosen by the primitive's
+ * number, small enough to clear for every ray; two primitives sharing a
+ * slot only cost a repeated test.  Measured: on SPD balls 13% fewer tests
+ * and 1-2% less time; on random rays through a 100k-triangle sphere, tests
+ * repeated fell from 5.7% to 0.1% and the rays ran 3% faster; its primary
+ * rays, which repeat 1%, ran as fast as before. */
+#define MAILBOX 8
+
 typedef struct {
     double org[3], inv[3], pad[3];
     uint32_t neg[3];
     int flat[3];
     double delta;
     double t0, t1;  /* the part of the ray inside the (grown) scene box */
+    int skip;       /* the caller's primitive never to test, or -1 */
+    int mail[MAILBOX];
 } kd_ray;
 
 /* A cell still to visit, with the stretch of the ray inside it. */
@@ -747,10 +762,12 @@ typedef struct {
  * every t or for none.  Half the rays of a typical view miss the scene box
  * and cost nothing else, so this is kept to one pass over the axes. */
 static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
-                     double tmin, double tmax, kd_ray *r)
+                     int skip, double tmin, double tmax, kd_ray *r)
 {
     double scale = t->scale, t0 = tmin, t1 = tmax;
     int a;
+    r->skip = skip;
+    for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
     for (a = 0; a < 3; a++) {
         double m = fabs(org[a]);
         if (!(m <= DBL_MAX) || !isfinite(dir[a])) return 0;
@@ -821,14 +838,16 @@ static uint32_t step(const kd_node *nd, const kd_ray *r, double *t0,
  * would; the callback gets tmax = the best t so far, inclusive, so that it
  * reports such ties.  Any-hit: the first hit will do. */
 static int test_leaf(const kd_tree *t, const kd_node *nd, const kd_prims *p,
-                     void *ray, double tmin, int any, double *best_t,
+                     kd_ray *r, void *ray, double tmin, int any, double *best_t,
                      int best, unsigned long long *tests)
 {
     const int *list = t->prims + node_index(nd);
     uint32_t k, n = nd->u.count;
     for (k = 0; k < n; k++) {
-        int i = list[k];
+        int i = list[k], *slot = &r->mail[i & (MAILBOX - 1)];
         double th;
+        if (i == r->skip || *slot == i) continue;
+        *slot = i;
         ++*tests;
         if (!p->hit(p->user, i, ray, tmin, *best_t, &th)) continue;
         if (any) return i;
@@ -857,7 +876,7 @@ static long pop(const kd_todo *stack, int *n, double best_t)
 }
 
 /* The walk shared by kd_nearest (any = 0) and kd_any (any = 1). */
-static int walk(const kd_tree *t, const kd_prims *p, const kd_ray *r,
+static int walk(const kd_tree *t, const kd_prims *p, kd_ray *r,
                 void *ray, double tmin, int any, double *best_t,
                 kd_counters *c)
 {
@@ -874,7 +893,7 @@ static int walk(const kd_tree *t, const kd_prims *p, const kd_ray *r,
             node = step(nd, r, &t0, &t1, stack, &n);
             continue;
         }
-        best = test_leaf(t, nd, p, ray, tmin, any, best_t, best, &tests);
+        best = test_leaf(t, nd, p, r, ray, tmin, any, best_t, best, &tests);
         if (any && best >= 0) break;
         next = pop(stack, &n, *best_t);
         if (next < 0) break;
@@ -885,25 +904,25 @@ static int walk(const kd_tree *t, const kd_prims *p, const kd_ray *r,
 }
 
 int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
-               const double dir[3], void *ray, double tmin,
+               const double dir[3], void *ray, int skip, double tmin,
                double *tmax, kd_counters *c)
 {
     kd_ray r;
     double best_t = *tmax;
     int i;
     if (c) c->rays++;
-    if (!t || !setup_ray(t, org, dir, tmin, *tmax, &r)) return -1;
+    if (!t || !setup_ray(t, org, dir, skip, tmin, *tmax, &r)) return -1;
     i = walk(t, p, &r, ray, tmin, 0, &best_t, c);
     if (i >= 0) *tmax = best_t;
     return i;
 }
 
 int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
-           const double dir[3], void *ray, double tmin, double tmax,
+           const double dir[3], void *ray, int skip, double tmin, double tmax,
            kd_counters *c)
 {
     kd_ray r;
     if (c) c->rays++;
-    if (!t || !setup_ray(t, org, dir, tmin, tmax, &r)) return 0;
+    if (!t || !setup_ray(t, org, dir, skip, tmin, tmax, &r)) return 0;
     return walk(t, p, &r, ray, tmin, 1, &tmax, c) >= 0;
 }

@@ -11,7 +11,7 @@
  *     kd_prims p = { my_bounds, my_clip_or_NULL, my_hit, my_scene };
  *     kd_tree *t = kd_build(n, &p);
  *     double tmax = INFINITY;
- *     int i = kd_nearest(t, &p, org, dir, &my_ray, 0.0, &tmax, &counters);
+ *     int i = kd_nearest(t, &p, org, dir, &my_ray, -1, 0.0, &tmax, &counters);
  *     ... i < 0 means no hit; otherwise primitive i at distance tmax ...
  *     kd_free(t);
  */
@@ -29,6 +29,9 @@ typedef struct {
                 double lo[3], double hi[3]);
     /* Intersect primitive i with the caller's ray (passed through untouched
      * as `ray`).  Returns 1 and sets *t when it hits at tmin < *t <= tmax.
+     * The tree does not repeat a test it has made for the same ray (see
+     * MAILBOX in kdtree.c), so a miss must stay a miss for any smaller tmax
+     * and t must not depend on tmax.
      * `ray` is not const: the callback may note things there, such as where
      * on the primitive its last hit lay, to spare the caller a second test.
      * The tree finds exactly what a loop over all primitives finds as long
@@ -62,14 +65,17 @@ kd_tree *kd_build(int n, const kd_prims *p);
 
 /* Nearest hit of the ray org + t*dir with tmin < t <= *tmax.  Returns the
  * primitive (ties in t go to the lower index, as a brute-force loop would)
- * and stores its t in *tmax; returns -1 and leaves *tmax alone on a miss. */
+ * and stores its t in *tmax; returns -1 and leaves *tmax alone on a miss.
+ * Primitive `skip` (-1: none) is never tested: the surface a ray leaves,
+ * when the caller knows the ray cannot meet it again. */
 int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
-               const double dir[3], void *ray, double tmin,
+               const double dir[3], void *ray, int skip, double tmin,
                double *tmax, kd_counters *c);
 
-/* 1 when any primitive is hit with tmin < t <= tmax: for shadow rays. */
+/* 1 when any primitive but `skip` is hit with tmin < t <= tmax: for
+ * shadow rays. */
 int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
-           const double dir[3], void *ray, double tmin, double tmax,
+           const double dir[3], void *ray, int skip, double tmin, double tmax,
            kd_counters *c);
 
 void kd_describe(const kd_tree *t, kd_info *info);

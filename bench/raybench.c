@@ -329,7 +329,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
             o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
             d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
             Query q = query(r);
-            obj[i] = kd_nearest(s->tree, &s->prims, o, d, &q, 0, &tmax, NULL);
+            obj[i] = kd_nearest(s->tree, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
             t[i] = tmax;
             if (obj[i] >= 0 && q.obj == obj[i]) {
                 const Triangle *tr = &s->tri[obj[i] - (nobj(s) - s->ntri)];
@@ -398,9 +398,10 @@ static void rb_compare(const Scene *s, const char *set, const RbRay *rays, long 
 
 /* How the walk spends its work, in an untimed pass: tree steps and hit tests
  * per ray, and how many tests repeat a primitive already tested for the same
- * ray.  A primitive listed in several leaves along the ray is tested in each
- * (kdtree.c keeps no "mailbox"); the repeats say what one would save.  The
- * tree's own hit callback is wrapped, so nothing in ray.c changes. */
+ * ray.  A primitive listed in several leaves along the ray would be tested
+ * in each; kdtree.c's mailbox (MAILBOX) stops that, and the repeats left are
+ * primitives that shared a slot of it.  The tree's own hit callback is
+ * wrapped, so nothing in ray.c changes. */
 static struct {
     int (*hit)(void *, int, void *, double, double, double *);
     unsigned long *mark;      /* per primitive: the last ray that tested it */
@@ -436,7 +437,7 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
         r.skip = -1;
         q = query(r);
         rb_probe.ray = (unsigned long)i + 1;
-        kd_nearest(s->tree, &s->prims, o, d, &q, 0, &tmax, &c);
+        kd_nearest(s->tree, &s->prims, o, d, &q, -1, 0, &tmax, &c);
     }
     s->prims.hit = rb_probe.hit;
     free(rb_probe.mark);

@@ -629,7 +629,7 @@ if part rays; then
       "$(rfield "$log" "" bytes_per_obj)" "$(rfield "$log" "" refs_per_obj)" "$(rfield "$log" "" depth)")")
   done
   {
-    echo "(steps, tests: tree steps and hit tests per ray; repeat%: tests of a primitive already tested by that ray)"
+    echo "(steps, tests: tree steps and hit tests per ray; repeat%: tests of a primitive already tested by that ray, which the mailbox missed)"
     [ ${#builds[@]} -gt 0 ] && printf '%s\n' "${builds[@]}"
     echo "($((SECONDS - t_part)) s)"
     echo

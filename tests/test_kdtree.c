@@ -591,47 +591,51 @@ static int make_ray(const scene *s, const box3 *b, const splits *sp, long k,
 
 /* ---- brute force ----------------------------------------------------- */
 
-static int brute_nearest(const scene *s, const ray *r, double tmin, double *tmax)
+static int brute_nearest(const scene *s, const ray *r, int skip, double tmin,
+                         double *tmax)
 {
     double best_t = *tmax, t;
     int i, best = -1;
     for (i = 0; i < s->n; i++)
-        if (test_prim(s, i, r, tmin, best_t, &t)
+        if (i != skip && test_prim(s, i, r, tmin, best_t, &t)
             && (t < best_t || (t == best_t && (best < 0 || i < best))))
             best_t = t, best = i;
     if (best >= 0) *tmax = best_t;
     return best;
 }
 
-static int brute_any(const scene *s, const ray *r, double tmin, double tmax)
+static int brute_any(const scene *s, const ray *r, int skip, double tmin, double tmax)
 {
     double t;
     int i;
     for (i = 0; i < s->n; i++)
-        if (test_prim(s, i, r, tmin, tmax, &t)) return 1;
+        if (i != skip && test_prim(s, i, r, tmin, tmax, &t)) return 1;
     return 0;
 }
 
 /* In the scene of identical triangles every primitive gives the same
  * answer as primitive 0 (same numbers, same code), so the loop's answer is
- * primitive 0's; the full loop is still run on every 1000th ray. */
-static int reference_nearest(const scene *s, const ray *r, double tmin,
+ * the first primitive not skipped; the full loop is still run on every
+ * 1000th ray. */
+static int reference_nearest(const scene *s, const ray *r, int skip, double tmin,
                              double *tmax, long k)
 {
     double t;
+    int first = skip == 0;
     if (strcmp(s->name, "same") || k % 1000 == 0)
-        return brute_nearest(s, r, tmin, tmax);
-    if (!test_prim(s, 0, r, tmin, *tmax, &t)) return -1;
+        return brute_nearest(s, r, skip, tmin, tmax);
+    if (first >= s->n || !test_prim(s, first, r, tmin, *tmax, &t)) return -1;
     *tmax = t;
-    return 0;
+    return first;
 }
 
-static int reference_any(const scene *s, const ray *r, double tmin,
+static int reference_any(const scene *s, const ray *r, int skip, double tmin,
                          double tmax, long k)
 {
     double t;
-    if (strcmp(s->name, "same") || k % 1000 == 0) return brute_any(s, r, tmin, tmax);
-    return test_prim(s, 0, r, tmin, tmax, &t);
+    int first = skip == 0;
+    if (strcmp(s->name, "same") || k % 1000 == 0) return brute_any(s, r, skip, tmin, tmax);
+    return first < s->n && test_prim(s, first, r, tmin, tmax, &t);
 }
 
 /* ---- checks ---------------------------------------------------------- */
@@ -647,6 +651,8 @@ static void report(int ok, const char *fmt, const char *name, const char *what)
 static void show_mismatch(const char *what, int kind, const ray *r, double tmin,
                           double tmax, int want, double wt, int got, double gt)
 {
+    static int shown;
+    if (shown++ >= 5) return;  /* the first few tell the story */
     fprintf(stderr, "%s mismatch (%s): org %a %a %a dir %a %a %a tmin %a tmax %a:"
             " brute %d t=%a, tree %d t=%a\n", what, kind_name[kind],
             r->o[0], r->o[1], r->o[2], r->d[0], r->d[1], r->d[2], tmin, tmax,
@@ -719,12 +725,45 @@ static double any_tmax(int nearest, double t, double tmax)
     }
 }
 
+/* One ray's nearest-hit check with primitive `skip` left out: 1 if the tree
+ * agrees with the loop; want, want_t: the loop's answer. */
+static int check_nearest(const scene *s, const kd_prims *p, const kd_tree *t,
+                         const ray *r, int kind, int skip, double tmin, double tmax,
+                         long k, int *want, double *want_t, kd_counters *c)
+{
+    double got_t = tmax;
+    int got;
+    *want_t = tmax;
+    *want = reference_nearest(s, r, skip, tmin, want_t, k);
+    got = kd_nearest(t, p, r->o, r->d, (void *)r, skip, tmin, &got_t, c);
+    if (*want == got && !memcmp(want_t, &got_t, sizeof(double))) return 1;
+    show_mismatch(skip < 0 ? "nearest" : "nearest with skip", kind, r, tmin, tmax,
+                  *want, *want_t, got, got_t);
+    return 0;
+}
+
+static int check_any(const scene *s, const kd_prims *p, const kd_tree *t,
+                     const ray *r, int kind, int skip, double tmin, double tmax,
+                     long k, int *want, kd_counters *c)
+{
+    int got;
+    *want = reference_any(s, r, skip, tmin, tmax, k);
+    got = kd_any(t, p, r->o, r->d, (void *)r, skip, tmin, tmax, c);
+    if (*want == got) return 1;
+    show_mismatch(skip < 0 ? "any" : "any with skip", kind, r, tmin, tmax, *want, 0, got, 0);
+    return 0;
+}
+
+/* Every ray: kd_nearest.  Every other ray: kd_any.  Every 8th ray, once
+ * more with its nearest primitive skipped (the surface a ray leaves, in
+ * ray.c): nearest on odd rays, any on even ones. */
 static void check_rays(const scene *s, const kd_prims *p, const kd_tree *t, long nrays)
 {
     box3 b;
     splits sp = get_splits(t);
     kd_counters c = {0, 0, 0};
-    long k, bad_near = 0, bad_any = 0, hits = 0, anys = 0, anyrays = 0;
+    long k, bad_near = 0, bad_any = 0, bad_skip = 0, hits = 0, anys = 0, anyrays = 0;
+    long skips = 0;
     long per_kind[KINDS] = {0}, bad_kind[KINDS] = {0};
     char msg[600], *m = msg;
     clock_t start = clock();
@@ -732,27 +771,28 @@ static void check_rays(const scene *s, const kd_prims *p, const kd_tree *t, long
     scene_box(s, &b);
     for (k = 0; k < nrays; k++) {
         ray r;
-        double tmin, tmax, want_t, got_t, ta;
-        int kind = make_ray(s, &b, &sp, k, &r, &tmin, &tmax), want, got;
+        double tmin, tmax, want_t, w2_t, ta;
+        int kind = make_ray(s, &b, &sp, k, &r, &tmin, &tmax), want, w2, ok;
         per_kind[kind]++;
-        want_t = got_t = tmax;
-        want = reference_nearest(s, &r, tmin, &want_t, k);
-        got = kd_nearest(t, p, r.o, r.d, &r, tmin, &got_t, &c);
+        ok = check_nearest(s, p, t, &r, kind, -1, tmin, tmax, k, &want, &want_t, &c);
         hits += want >= 0;
-        if (want != got || memcmp(&want_t, &got_t, sizeof(double))) {
-            if (bad_near++ < 5) show_mismatch("nearest", kind, &r, tmin, tmax, want, want_t, got, got_t);
-            bad_kind[kind]++;
+        if (!ok) bad_near++, bad_kind[kind]++;
+        if (k % 8 == 1 && want >= 0) {
+            skips++;
+            if (!check_nearest(s, p, t, &r, kind, want, tmin, tmax, k, &w2, &w2_t, &c))
+                bad_skip++, bad_kind[kind]++;
         }
         if (k % 2) continue;  /* kd_any on every other ray */
         anyrays++;
         ta = any_tmax(want, want_t, tmax);
-        want = reference_any(s, &r, tmin, ta, k);
-        got = kd_any(t, p, r.o, r.d, &r, tmin, ta, &c);
-        anys += want;
-        if (want != got) {
-            if (bad_any++ < 5) show_mismatch("any", kind, &r, tmin, ta, want, 0, got, 0);
-            bad_kind[kind]++;
+        if (k % 8 == 2 && want >= 0) {
+            skips++;
+            if (!check_any(s, p, t, &r, kind, want, tmin, ta, k, &w2, &c))
+                bad_skip++, bad_kind[kind]++;
         }
+        ok = check_any(s, p, t, &r, kind, -1, tmin, ta, k, &w2, &c);
+        anys += w2;
+        if (!ok) bad_any++, bad_kind[kind]++;
     }
     m += sprintf(m, "%ld rays, %ld hit, %ld mismatches; %.2f steps and %.2f "
                  "tests per ray (brute force: %d); %.1f s; by kind:", nrays, hits,
@@ -760,10 +800,14 @@ static void check_rays(const scene *s, const kd_prims *p, const kd_tree *t, long
                  s->n, (double)(clock() - start) / CLOCKS_PER_SEC);
     for (j = 0; j < KINDS; j++)
         m += sprintf(m, " %s %ld/%ld", kind_name[j], bad_kind[j], per_kind[j]);
-    report(bad_near == 0 && c.rays == (unsigned long long)(nrays + anyrays), msg, s->name, "nearest");
+    report(bad_near == 0 && c.rays == (unsigned long long)(nrays + anyrays + skips), msg,
+           s->name, "nearest");
     sprintf(msg, "%ld rays, %ld blocked, %ld mismatches%s", anyrays, anys, bad_any,
             strcmp(s->name, "same") ? "" : " (full loop on every 1000th ray)");
     report(bad_any == 0, msg, s->name, "any");
+    sprintf(msg, "%ld rays again with their nearest primitive skipped (nearest and any), "
+            "%ld mismatches", skips, bad_skip);
+    report(bad_skip == 0 && (skips > 0 || hits == 0), msg, s->name, "skip");
     free(sp.axis), free(sp.pos);
 }
 

@@ -634,11 +634,11 @@ static int acne_at_scale(double k, int *counted)
         for (i = 0; i < W; i++) {
             Hit h;
             real e;
-            vec to_l, oc;
+            vec to_l, oc, ld;
             double b, dist2, len;
             int lit, truth;
             if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &st)) continue;
-            lit = shadow_ray(&s, &h, h.n, l, &e, &st);
+            lit = shadow_ray(&s, &h, h.n, l, &e, &ld, &st);
             if (!(e > 1e-6)) continue;     /* grazing or facing away */
             /* exact: does the segment from the point to the light pass
              * through the ball (if the point is on the ground), in units of k */
@@ -685,9 +685,10 @@ static int lone_acne(int cylinder, double k, double far, int *counted)
         for (i = 0; i < W; i++) {
             Hit h;
             real e;
+            vec ld;
             int lit;
             if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &st)) continue;
-            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], &e, &st);
+            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], &e, &ld, &st);
             if (!(e > 1e-6)) continue;
             ++*counted;
             wrong += !lit || self_hit(&s, &h, unit(sub(s.light[0].pos, h.p)));
