@@ -719,14 +719,6 @@ long kd_splits(const kd_tree *t, int *axis, double *pos, long max)
 
 /* ---- traversal ---------------------------------------------------------- */
 
-/* The ray as the walk needs it.  inv is 1/dir, and +-infinity for +-0; a
- * zero component is "flat": the ray runs parallel to that axis's planes.
- * neg says which way the ray runs along each axis, from the sign bit, so
- * that -0 counts as negative like its 1/d = -inf.  pad[a] is the margin
- * delta (see RAY_EPS) in units of t along axis a.  A denormal component can
- * make inv and pad infinite and the plane crossings NaN; every comparison
- * below is written so that NaN means "visit", which is always safe.  The
- * origin is copied, not pointed to: the walk reads it at every step. */
 /* A primitive listed in several cells (one that straddles a plane) would be
  * tested again in each cell the ray visits, yet the answer cannot change: a
  * miss stays a miss under a smaller tmax, and a hit lies at or beyond the
@@ -740,6 +732,14 @@ long kd_splits(const kd_tree *t, int *axis, double *pos, long max)
  * rays, which repeat 1%, ran as fast as before. */
 #define MAILBOX 8
 
+/* The ray as the walk needs it.  inv is 1/dir, and +-infinity for +-0; a
+ * zero component is "flat": the ray runs parallel to that axis's planes.
+ * neg says which way the ray runs along each axis, from the sign bit, so
+ * that -0 counts as negative like its 1/d = -inf.  pad[a] is the margin
+ * delta (see RAY_EPS) in units of t along axis a.  A denormal component can
+ * make inv and pad infinite and the plane crossings NaN; every comparison
+ * below is written so that NaN means "visit", which is always safe.  The
+ * origin is copied, not pointed to: the walk reads it at every step. */
 typedef struct {
     double org[3], inv[3], pad[3];
     uint32_t neg[3];
