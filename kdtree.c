@@ -923,6 +923,6 @@ int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
 {
     kd_ray r;
     if (c) c->rays++;
-    if (!t || !setup_ray(t, org, dir, skip, tmin, tmax, &r)) return 0;
-    return walk(t, p, &r, ray, tmin, 1, &tmax, c) >= 0;
+    if (!t || !setup_ray(t, org, dir, skip, tmin, tmax, &r)) return -1;
+    return walk(t, p, &r, ray, tmin, 1, &tmax, c);
 }

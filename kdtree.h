@@ -72,8 +72,9 @@ int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
                const double dir[3], void *ray, int skip, double tmin,
                double *tmax, kd_counters *c);
 
-/* 1 when any primitive but `skip` is hit with tmin < t <= tmax: for
- * shadow rays. */
+/* A primitive other than `skip` hit with tmin < t <= tmax, whichever the
+ * walk meets first (not the nearest); -1 when there is none.  For shadow
+ * rays. */
 int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
            const double dir[3], void *ray, int skip, double tmin, double tmax,
            kd_counters *c);
