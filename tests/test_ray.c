@@ -418,7 +418,7 @@ static void test_tree_image(void)
     set_camera(&s, (Where){ "", 0 }, v);
     build_tree(&s, "kd");
     for (j = 0; j < W; j++) {
-        for (k = 0; k < 8; k++) st.blocker[k] = -1;
+        for (k = 0; k < SHADOW_SLOTS; k++) st.blocker[k] = -1;
         for (i = 0; i < W; i++) {
             Ray r = camera_ray(&s.cam, W, W, i + 0.5, j + 0.5);
             kd_tree *tree = s.tree;
