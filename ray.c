@@ -670,11 +670,12 @@ static int any_hit(const Scene *s, Ray r, real tmax, int *last, Stats *st)
         double o[3], d[3];
         kd_counters c = { 0, 0, 0 };
         int hit;
-        Query q = query(r);
+        Query q;
         if (*last >= 0) {
             st->tests++;
             if (hit_object(s, *last, &r, tmax, &t)) return 1;
         }
+        q = query(r);
         to3(r.o, o);
         to3(r.d, d);
         hit = kd_any(s->tree, &s->prims, o, d, &q, r.skip, 0, tmax, &c);
