@@ -14,7 +14,7 @@ PROGS = ray minray tools/ppmdiff
 
 all: $(PROGS)
 
-ray: ray.c kdtree.c kdtree.h
+ray: ray.c kdtree.c kdtree.h prims.h
 	$(CC) $(CFLAGS) $(OMP) -o $@ ray.c kdtree.c $(LDLIBS)
 
 # The card is K&R C with implicit int: -w keeps its historical text quiet.

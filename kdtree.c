@@ -228,7 +228,7 @@ static int alloc_list(kd_list *L, long cap)
 enum { LEFT = 1, RIGHT = 2, BOTH = 3 };
 
 typedef struct {
-    const kd_prims *p;
+    const prims *p;
     kd_node *nodes;
     long nnodes, node_cap;
     int *refs;
@@ -661,7 +661,7 @@ static kd_tree *finish(kd_builder *b, const kd_box *scene)
     return t;
 }
 
-kd_tree *kd_build(int n, const kd_prims *p)
+kd_tree *kd_build(int n, const prims *p)
 {
     clock_t start = clock();
     kd_builder b;
@@ -837,7 +837,7 @@ static uint32_t step(const kd_node *nd, const kd_ray *r, double *t0,
  * t, and on equal t the lower primitive number, as the brute-force loop
  * would; the callback gets tmax = the best t so far, inclusive, so that it
  * reports such ties.  Any-hit: the first hit will do. */
-static int test_leaf(const kd_tree *t, const kd_node *nd, const kd_prims *p,
+static int test_leaf(const kd_tree *t, const kd_node *nd, const prims *p,
                      kd_ray *r, void *ray, double tmin, int any, double *best_t,
                      int best, unsigned long long *tests)
 {
@@ -876,9 +876,9 @@ static long pop(const kd_todo *stack, int *n, double best_t)
 }
 
 /* The walk shared by kd_nearest (any = 0) and kd_any (any = 1). */
-static int walk(const kd_tree *t, const kd_prims *p, kd_ray *r,
+static int walk(const kd_tree *t, const prims *p, kd_ray *r,
                 void *ray, double tmin, int any, double *best_t,
-                kd_counters *c)
+                prim_counters *c)
 {
     kd_todo stack[STACK_SIZE];
     int n = 0, best = -1;
@@ -903,9 +903,9 @@ static int walk(const kd_tree *t, const kd_prims *p, kd_ray *r,
     return best;
 }
 
-int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
+int kd_nearest(const kd_tree *t, const prims *p, const double org[3],
                const double dir[3], void *ray, int skip, double tmin,
-               double *tmax, kd_counters *c)
+               double *tmax, prim_counters *c)
 {
     kd_ray r;
     double best_t = *tmax;
@@ -917,9 +917,9 @@ int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
     return i;
 }
 
-int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
+int kd_any(const kd_tree *t, const prims *p, const double org[3],
            const double dir[3], void *ray, int skip, double tmin, double tmax,
-           kd_counters *c)
+           prim_counters *c)
 {
     kd_ray r;
     if (c) c->rays++;

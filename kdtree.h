@@ -1,14 +1,14 @@
 /* kdtree.h - a kd-tree over primitives it knows only through callbacks.
  *
  * The tree never sees a sphere or a triangle: the caller describes its
- * primitives with three callbacks (a bounding box, an optional clip to a box,
- * a ray intersection) and the tree answers "which primitive does this ray hit
- * first" and "does anything block this ray".  See kdtree.c for the build
+ * primitives with the callbacks of prims.h (a bounding box, an optional clip
+ * to a box, a ray intersection) and the tree answers "which primitive does
+ * this ray hit first" and "does anything block this ray".  See kdtree.c for the build
  * (surface area heuristic, O(N log N), Wald & Havran 2006) and the traversal
  * (Kaplan's near/far order, 1985).
  *
  * Usage:
- *     kd_prims p = { my_bounds, my_clip_or_NULL, my_hit, my_scene };
+ *     prims p = { my_bounds, my_clip_or_NULL, my_hit, my_scene };
  *     kd_tree *t = kd_build(n, &p);
  *     double tmax = INFINITY;
  *     int i = kd_nearest(t, &p, org, dir, &my_ray, -1, 0.0, &tmax, &counters);
@@ -18,35 +18,9 @@
 #ifndef KDTREE_H
 #define KDTREE_H
 #include <stddef.h>
-
-typedef struct {
-    /* The axis-aligned box of primitive i. */
-    void (*bounds)(void *user, int i, double lo[3], double hi[3]);
-    /* Optional (NULL: use bounds). The box of the part of primitive i that
-     * lies inside [blo,bhi]; returns 0 when nothing of it is inside.  Lets the
-     * build make "perfect splits" (Havran 2000) for long thin primitives. */
-    int (*clip)(void *user, int i, const double blo[3], const double bhi[3],
-                double lo[3], double hi[3]);
-    /* Intersect primitive i with the caller's ray (passed through untouched
-     * as `ray`).  Returns 1 and sets *t when it hits at tmin < *t <= tmax.
-     * The tree does not repeat a test it has made for the same ray (see
-     * MAILBOX in kdtree.c), so a miss must stay a miss for any smaller tmax
-     * and t must not depend on tmax.
-     * `ray` is not const: the callback may note things there, such as where
-     * on the primitive its last hit lay, to spare the caller a second test.
-     * The tree finds exactly what a loop over all primitives finds as long
-     * as the point org + t*dir of a reported hit lies in the primitive's box
-     * (its clipped box, with clip), give or take a margin of 1e-7 times the
-     * largest coordinate of the scene and the ray origin. */
-    int (*hit)(void *user, int i, void *ray, double tmin, double tmax,
-               double *t);
-    void *user;
-} kd_prims;
+#include "prims.h"
 
 typedef struct kd_tree kd_tree;
-
-/* Per-ray work, for --stats; either pointer argument below may be NULL. */
-typedef struct { unsigned long long rays, steps, tests; } kd_counters;
 
 /* Shape of a built tree, for --stats. */
 typedef struct {
@@ -61,23 +35,23 @@ typedef struct {
  * memory (or past 2^30 nodes or primitive references).  The build is
  * deterministic: same input, same tree.  Boxes are kept in float; a
  * primitive whose box is NaN or has lo > hi is left out. */
-kd_tree *kd_build(int n, const kd_prims *p);
+kd_tree *kd_build(int n, const prims *p);
 
 /* Nearest hit of the ray org + t*dir with tmin < t <= *tmax.  Returns the
  * primitive (ties in t go to the lower index, as a brute-force loop would)
  * and stores its t in *tmax; returns -1 and leaves *tmax alone on a miss.
  * Primitive `skip` (-1: none) is never tested: the surface a ray leaves,
  * when the caller knows the ray cannot meet it again. */
-int kd_nearest(const kd_tree *t, const kd_prims *p, const double org[3],
+int kd_nearest(const kd_tree *t, const prims *p, const double org[3],
                const double dir[3], void *ray, int skip, double tmin,
-               double *tmax, kd_counters *c);
+               double *tmax, prim_counters *c);
 
 /* A primitive other than `skip` hit with tmin < t <= tmax, whichever the
  * walk meets first (not the nearest); -1 when there is none.  For shadow
  * rays. */
-int kd_any(const kd_tree *t, const kd_prims *p, const double org[3],
+int kd_any(const kd_tree *t, const prims *p, const double org[3],
            const double dir[3], void *ray, int skip, double tmin, double tmax,
-           kd_counters *c);
+           prim_counters *c);
 
 void kd_describe(const kd_tree *t, kd_info *info);
 void kd_free(kd_tree *t);

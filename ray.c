@@ -161,7 +161,7 @@ typedef struct {
     vec ambient, background;
     int cull;                 /* for triangles still to come: `sided 1` */
     kd_tree *tree;            /* NULL: nearest_hit tests every object */
-    kd_prims prims;
+    prims prims;
 } Scene;
 
 /* Objects are numbered spheres first, then cones, then triangles. */
@@ -631,7 +631,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Stats *st)
     st->nearest++;
     if (s->tree) {
         double o[3], d[3], tmax = INFINITY;
-        kd_counters c = { 0, 0, 0 };
+        prim_counters c = { 0, 0, 0 };
         to3(r.o, o);
         to3(r.d, d);
         best = kd_nearest(s->tree, &s->prims, o, d, &q, r.skip, 0, &tmax, &c);
@@ -668,7 +668,7 @@ static int any_hit(const Scene *s, Ray r, real tmax, int *last, Stats *st)
     st->queries++;
     if (s->tree) {
         double o[3], d[3];
-        kd_counters c = { 0, 0, 0 };
+        prim_counters c = { 0, 0, 0 };
         int hit;
         Query q;
         if (*last >= 0) {

@@ -419,7 +419,7 @@ static int rb_counting_hit(void *user, int i, void *ray, double tmin, double tma
 
 static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
 {
-    kd_counters c = { 0, 0, 0 };
+    prim_counters c = { 0, 0, 0 };
     long i;
     rb_probe.hit = s->prims.hit;
     rb_probe.mark = calloc((size_t)nobj(s), sizeof *rb_probe.mark);

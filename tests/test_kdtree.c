@@ -684,7 +684,7 @@ static void check_shape(const scene *s, const kd_tree *t)
     report(ok, msg, s->name, "tree");
 }
 
-static void check_determinism(const scene *s, const kd_prims *p, const kd_tree *t)
+static void check_determinism(const scene *s, const prims *p, const kd_tree *t)
 {
     kd_tree *again = kd_build(s->n, p);
     size_t n1, n2;
@@ -728,9 +728,9 @@ static double any_tmax(int nearest, double t, double tmax)
 
 /* One ray's nearest-hit check with primitive `skip` left out: 1 if the tree
  * agrees with the loop; want, want_t: the loop's answer. */
-static int check_nearest(const scene *s, const kd_prims *p, const kd_tree *t,
+static int check_nearest(const scene *s, const prims *p, const kd_tree *t,
                          const ray *r, int kind, int skip, double tmin, double tmax,
-                         long k, int *want, double *want_t, kd_counters *c)
+                         long k, int *want, double *want_t, prim_counters *c)
 {
     double got_t = tmax;
     int got;
@@ -743,9 +743,9 @@ static int check_nearest(const scene *s, const kd_prims *p, const kd_tree *t,
     return 0;
 }
 
-static int check_any(const scene *s, const kd_prims *p, const kd_tree *t,
+static int check_any(const scene *s, const prims *p, const kd_tree *t,
                      const ray *r, int kind, int skip, double tmin, double tmax,
-                     long k, int *want, kd_counters *c)
+                     long k, int *want, prim_counters *c)
 {
     int got;
     double tg;
@@ -762,11 +762,11 @@ static int check_any(const scene *s, const kd_prims *p, const kd_tree *t,
 /* Every ray: kd_nearest.  Every other ray: kd_any.  Every 8th ray, once
  * more with its nearest primitive skipped (the surface a ray leaves, in
  * ray.c): nearest on odd rays, any on even ones. */
-static void check_rays(const scene *s, const kd_prims *p, const kd_tree *t, long nrays)
+static void check_rays(const scene *s, const prims *p, const kd_tree *t, long nrays)
 {
     box3 b;
     splits sp = get_splits(t);
-    kd_counters c = {0, 0, 0};
+    prim_counters c = {0, 0, 0};
     long k, bad_near = 0, bad_any = 0, bad_skip = 0, hits = 0, anys = 0, anyrays = 0;
     long skips = 0;
     long per_kind[KINDS] = {0}, bad_kind[KINDS] = {0};
@@ -819,7 +819,7 @@ static void check_rays(const scene *s, const kd_prims *p, const kd_tree *t, long
 int main(int argc, char **argv)
 {
     scene s;
-    kd_prims p;
+    prims p;
     kd_tree *t;
     long nrays = 1000000;
     const char *env = getenv("KD_RAYS");
