@@ -266,7 +266,7 @@ static int rb_white(Scene *s)
  * and naming each would tie the bench to every field of a Scene in flux. */
 static void rb_free_scene(Scene *s)
 {
-    if (s->tree) kd_free(s->tree);
+    if (s->kd) kd_free(s->kd);
     free(s->mat); free(s->sph); free(s->tri); free(s->vert); free(s->norm); free(s->light);
 }
 
@@ -284,7 +284,7 @@ static void rb_load_mesh(Scene *s, const char *path)
 static double rb_build(Scene *s)
 {
     double t0 = rb_now();
-    if (!build_tree(s, "kd") || !s->tree) rb_die("kd-tree build failed", NULL);
+    if (!build_accel(s, "kd") || !s->kd) rb_die("kd-tree build failed", NULL);
     return rb_now() - t0;
 }
 
@@ -292,7 +292,7 @@ static double rb_build(Scene *s)
 static void rb_tree_line(const Scene *s, double seconds)
 {
     kd_info k;
-    kd_describe(s->tree, &k);
+    kd_describe(s->kd, &k);
     printf("kd-tree    %d objects, built in %.3f s: %ld nodes, depth %ld, %.2f refs/object, "
            "%.1f bytes/object, SAH cost %.2f\n", nobj(s), seconds, k.nodes, k.max_depth,
            (double)k.prim_refs / nobj(s), (double)k.bytes / nobj(s), k.sah_cost);
@@ -314,10 +314,10 @@ static void rb_tree_line(const Scene *s, double seconds)
 static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int *obj, double *t,
                        double *uvn, double *cpu)
 {
-    Stats st;
+    Worker wk;
     double t0, c0 = rb_cpu();
     long i;
-    memset(&st, 0, sizeof st);
+    memset(&wk, 0, sizeof wk);
     t0 = rb_now();
     for (i = 0; i < n; i++) {
         Ray r;
@@ -329,7 +329,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
             o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
             d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
             Query q = query(r);
-            obj[i] = kd_nearest(s->tree, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
+            obj[i] = kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
             t[i] = tmax;
             if (obj[i] >= 0 && q.obj == obj[i]) {
                 const Triangle *tr = &s->tri[obj[i] - (nobj(s) - s->ntri)];
@@ -339,7 +339,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
             }
         } else {
             Hit h;
-            if (nearest_hit(s, r, &h, &st)) obj[i] = h.obj, t[i] = h.t;
+            if (nearest_hit(s, r, &h, &wk)) obj[i] = h.obj, t[i] = h.t;
             else obj[i] = -1, t[i] = INFINITY;
         }
     }
@@ -437,7 +437,7 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
         r.skip = -1;
         q = query(r);
         rb_probe.ray = (unsigned long)i + 1;
-        kd_nearest(s->tree, &s->prims, o, d, &q, -1, 0, &tmax, &c);
+        kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, &c);
     }
     s->prims.hit = rb_probe.hit;
     free(rb_probe.mark);
@@ -542,12 +542,12 @@ static void rb_build_table(long maxn)
         rb_cube_sphere(&s, k);
         n = nobj(&s);
         do {
-            if (s.tree) kd_free(s.tree), s.tree = NULL;
+            if (s.kd) kd_free(s.kd), s.kd = NULL;
             secs = rb_build(&s);
             if (secs < best) best = secs;
             runs++;
         } while (runs < (best < 1 ? RB_REPEAT : best < 3 ? 2 : 1));
-        kd_describe(s.tree, &info);
+        kd_describe(s.kd, &info);
         printf("%10d %9.3f %5d %10.0f %9ld %6ld %9.2f %10.1f %9.2f\n", n, best, runs, best / n * 1e9,
                info.nodes, info.max_depth, (double)info.prim_refs / n, (double)info.bytes / n,
                info.sah_cost);

@@ -273,13 +273,13 @@ static double rnd(unsigned long long *x)
 static void test_watertight(int shared)
 {
     Scene s = tri_scene(0);
-    Stats st;
+    Worker wk;
     unsigned long long x = 42;
     int r, escapes = 0, n = 1000000;
     char name[96];
-    memset(&st, 0, sizeof st);
+    memset(&wk, 0, sizeof wk);
     uv_sphere(&s, 8, 16, shared);
-    build_tree(&s, shared ? "kd" : "none");   /* one through the tree, one through the loop */
+    build_accel(&s, shared ? "kd" : "none");   /* one through the tree, one through the loop */
     for (r = 0; r < n; r++) {
         const Triangle *t = &s.tri[(int)(rnd(&x) * s.ntri)];
         int e = (int)(rnd(&x) * 3);
@@ -288,7 +288,7 @@ static void test_watertight(int shared)
         Hit h;
         o = v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5);
         target = comb(f, sub(b, a), a);
-        if (!nearest_hit(&s, ray(o, unit(sub(target, o))), &h, &st)) escapes++;
+        if (!nearest_hit(&s, ray(o, unit(sub(target, o))), &h, &wk)) escapes++;
     }
     sprintf(name, "watertight: rays at the vertices and edges of a closed mesh (%s vertices)",
             shared ? "shared" : "repeated");
@@ -296,12 +296,12 @@ static void test_watertight(int shared)
     free_scene(&s);
 }
 
-/* clip_sphere gives the tree the box of the part of a sphere inside a
+/* sphere_clip gives the tree the box of the part of a sphere inside a
  * cell.  Every point of the sphere that lies in the cell must lie in that
  * box (else the tree could miss a hit there), and the box must be tighter
  * than the sphere's own box cut to the cell (else it is no use).  Points:
  * 2000 on each of 2000 random spheres, cells random boxes across them. */
-static void test_clip_sphere(void)
+static void test_sphere_clip(void)
 {
     unsigned long long x = 7;
     long outside = 0, inside = 0, cells = 0;
@@ -317,7 +317,7 @@ static void test_clip_sphere(void)
             double p = c[a] + sp.rad * (3 * rnd(&x) - 1.5), q = c[a] + sp.rad * (3 * rnd(&x) - 1.5);
             blo[a] = fmin(p, q), bhi[a] = fmax(p, q);
         }
-        if (!clip_sphere(&sp, blo, bhi, lo, hi)) lo[0] = hi[0] = NAN;   /* "nothing inside" */
+        if (!sphere_clip(&sp, blo, bhi, lo, hi)) lo[0] = hi[0] = NAN;   /* "nothing inside" */
         else {
             cells++;
             for (a = 0; a < 3; a++) {
@@ -350,10 +350,10 @@ static void test_clip_sphere(void)
 static void test_tree_matches_loop(void)
 {
     Scene s = tri_scene(0);
-    Stats st;
+    Worker wk;
     unsigned long long x = 7;
     int r, k, wrong = 0, n = 1000000;
-    memset(&st, 0, sizeof st);
+    memset(&wk, 0, sizeof wk);
     uv_sphere(&s, 6, 12, 1);
     for (k = 0; k < 60; k++) {          /* random spheres and triangles in [-3, 3]^3 */
         vec c = v3(6 * rnd(&x) - 3, 6 * rnd(&x) - 3, 6 * rnd(&x) - 3);
@@ -364,12 +364,11 @@ static void test_tree_matches_loop(void)
     add_cone(&s, v3(0, 0, -2), 0.5, v3(0, 0, 2), 0.5, 0);      /* along z: axis-parallel rays */
     tri(&s, v3(-4, -4, -1), v3(4, -4, -1), v3(-4, 4, -1));     /* axis-aligned: splits land on it */
     tri(&s, v3(0, 0, 0), v3(0, 2, 0), v3(0, 0, 2));
-    build_tree(&s, "kd");
+    build_accel(&s, "kd");
     for (r = 0; r < n; r++) {
         Hit a, b;
         int ha, hb;
         Ray ry;
-        kd_tree *tree = s.tree;
         ry.skip = -1;
         ry.o = v3(8 * rnd(&x) - 4, 8 * rnd(&x) - 4, 8 * rnd(&x) - 4);
         ry.d = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5));
@@ -379,10 +378,10 @@ static void test_tree_matches_loop(void)
         case 3: ry.o.x = 0; ry.d.x = 0; ry.d = unit(ry.d); break; /* in the plane x = 0 */
         case 4: ry.o = scale(0.01, ry.o); break;              /* inside the scene box */
         }
-        ha = nearest_hit(&s, ry, &a, &st);
-        s.tree = NULL;
-        hb = nearest_hit(&s, ry, &b, &st);
-        s.tree = tree;
+        ha = nearest_hit(&s, ry, &a, &wk);
+        s.accel = ACCEL_NONE;
+        hb = nearest_hit(&s, ry, &b, &wk);
+        s.accel = ACCEL_KD;
         if (ha != hb || (ha && (a.obj != b.obj || a.t != b.t))) wrong++;
     }
     report(wrong == 0, "kd-tree = loop (spheres, cones, triangles): same object and t, 1e6 rays (axis-parallel, in planes, inside)",
@@ -400,11 +399,11 @@ static void test_tree_image(void)
 {
     Scene s = tri_scene(0);
     Material mirror;
-    Stats st;
+    Worker wk;
     unsigned long long x = 3;
     real v[10] = { 0, -9, 6, 0, 0, 0.5, 0, 0, 1, 45 };
     int i, j, k, W = 96, wrong = 0, mat;
-    memset(&st, 0, sizeof st);
+    memset(&wk, 0, sizeof wk);
     mirror = s.mat[0];
     mirror.kd = 0.6, mirror.ks = 0.4, mirror.shine = 20;
     mat = add_material(&s, mirror);
@@ -416,16 +415,15 @@ static void test_tree_image(void)
     add_light(&s, v3(0.3, 0.2, 0.6), v3(0.4, 0.4, 0.4), -1);
     add_light(&s, v3(-1.5, 1.1, 0.4), v3(0.3, 0.3, 0.3), -1);
     set_camera(&s, (Where){ "", 0 }, v);
-    build_tree(&s, "kd");
+    build_accel(&s, "kd");
     for (j = 0; j < W; j++) {
-        for (k = 0; k < SHADOW_SLOTS; k++) st.blocker[k] = -1;
+        for (k = 0; k < SHADOW_SLOTS; k++) wk.blocker[k] = -1;
         for (i = 0; i < W; i++) {
             Ray r = camera_ray(&s.cam, W, W, i + 0.5, j + 0.5);
-            kd_tree *tree = s.tree;
-            vec a = trace(&s, r, s.depth, 1, &st), b;
-            s.tree = NULL;
-            b = trace(&s, r, s.depth, 1, &st);
-            s.tree = tree;
+                vec a = trace(&s, r, s.depth, 1, &wk), b;
+            s.accel = ACCEL_NONE;
+            b = trace(&s, r, s.depth, 1, &wk);
+            s.accel = ACCEL_KD;
             wrong += memcmp(&a, &b, sizeof a) != 0;
         }
     }
@@ -606,14 +604,14 @@ static void test_no_nan(void)
     int f, bad = 0, pixels = 0;
     for (f = 0; f < 5; f++) {
         Scene s;
-        Stats st;
+        Worker wk;
         int i, j, W = 48;
-        memset(&st, 0, sizeof st);
+        memset(&wk, 0, sizeof wk);
         if (!load_scene(&s, files[f] ? files[f] : odd)) { bad++; continue; }
-        build_tree(&s, "auto");
+        build_accel(&s, "auto");
         for (j = 0; j < W; j++)
             for (i = 0; i < W; i++) {
-                vec c = trace(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), s.depth, 1, &st);
+                vec c = trace(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), s.depth, 1, &wk);
                 bad += !isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z);
                 pixels++;
             }
@@ -662,9 +660,9 @@ static int acne_at_scale(double k, int *counted)
     Scene s;
     Light *l;
     int i, j, wrong = 0, W = 96;
-    Stats st;
+    Worker wk;
     real v[10];
-    memset(&st, 0, sizeof st);
+    memset(&wk, 0, sizeof wk);
     s = tri_scene(0);                   /* a scene with one white material */
     add_sphere(&s, v3(0, 0, -1e4 * k), 1e4 * k, 0);
     add_sphere(&s, v3(0, 0, k), k, 0);
@@ -681,8 +679,8 @@ static int acne_at_scale(double k, int *counted)
             vec to_l, oc, ld;
             double b, dist2, len;
             int lit, truth;
-            if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &st)) continue;
-            lit = shadow_ray(&s, &h, h.n, l, &e, &ld, &st);
+            if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &wk)) continue;
+            lit = shadow_ray(&s, &h, h.n, l, &e, &ld, &wk);
             if (!(e > 1e-6)) continue;     /* grazing or facing away */
             /* exact: does the segment from the point to the light pass
              * through the ball (if the point is on the ground), in units of k */
@@ -710,10 +708,10 @@ static int acne_at_scale(double k, int *counted)
 static int lone_acne(int cylinder, double k, double far, int *counted)
 {
     Scene s;
-    Stats st;
+    Worker wk;
     real v[10];
     int i, j, wrong = 0, W = 64;
-    memset(&st, 0, sizeof st);
+    memset(&wk, 0, sizeof wk);
     s = tri_scene(0);
     if (cylinder) add_cone(&s, v3(0, 0, -k), k, v3(0, 0, k), k, 0);
     else {
@@ -731,8 +729,8 @@ static int lone_acne(int cylinder, double k, double far, int *counted)
             real e;
             vec ld;
             int lit;
-            if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &st)) continue;
-            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], &e, &ld, &st);
+            if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &wk)) continue;
+            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], &e, &ld, &wk);
             if (!(e > 1e-6)) continue;
             ++*counted;
             wrong += !lit || self_hit(&s, &h, unit(sub(s.light[0].pos, h.p)));
@@ -787,7 +785,7 @@ int main(void)
     test_obj();
     test_watertight(1);
     test_watertight(0);
-    test_clip_sphere();
+    test_sphere_clip();
     test_tree_matches_loop();
     test_tree_image();
     test_acne();
