@@ -53,6 +53,17 @@ int kd_any(const kd_tree *t, const prims *p, const double org[3],
            const double dir[3], void *ray, int skip, double tmin, double tmax,
            prim_counters *c);
 
+/* Readable reference; the iterative walk is the fast path.  Kaplan's
+ * TreeIntersect as the lecture's slide writes it, recursive.  any = 0: what
+ * kd_nearest returns, the same primitive and the same t in *tmax.  any = 1:
+ * what kd_any returns, the same primitive; *tmax is left alone.  It visits
+ * the same cells in the same order as kd_nearest and kd_any, so the
+ * counters get the same steps and tests. */
+int kd_intersect_recursive(const kd_tree *t, const prims *p,
+                           const double org[3], const double dir[3],
+                           void *ray, int skip, double tmin, double *tmax,
+                           int any, prim_counters *c);
+
 void kd_describe(const kd_tree *t, kd_info *info);
 void kd_free(kd_tree *t);
 

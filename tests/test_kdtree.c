@@ -9,7 +9,10 @@
  *     for i in 0..n-1: if hit(i, tmin, best_t) and t < best_t: best = i
  * (a tie in t keeps the lower index), and kd_any (on every other ray) must
  * agree with a loop that stops at the first hit, and return a primitive
- * that is hit in range.  For long runs: $KD_SCALE
+ * that is hit in range.  Every one of these queries is asked again of
+ * kd_intersect_recursive, the slide's recursive TreeIntersect, which must
+ * give what kd_nearest and kd_any give: the same primitive, bitwise the same
+ * t, and the same numbers of steps and tests.  For long runs: $KD_SCALE
  * multiplies the scenes' sizes, $KD_SEED picks other random scenes and rays.
  *
  * The test scenes put their vertices on coarse dyadic grids, and most
@@ -649,15 +652,18 @@ static void report(int ok, const char *fmt, const char *name, const char *what)
     failures += !ok;
 }
 
+/* want and got: the answers of the reference and of the code under test,
+ * named by the labels `a` and `b`. */
 static void show_mismatch(const char *what, int kind, const ray *r, double tmin,
-                          double tmax, int want, double wt, int got, double gt)
+                          double tmax, const char *a, int want, double wt,
+                          const char *b, int got, double gt)
 {
     static int shown;
     if (shown++ >= 5) return;  /* the first few tell the story */
     fprintf(stderr, "%s mismatch (%s): org %a %a %a dir %a %a %a tmin %a tmax %a:"
-            " brute %d t=%a, tree %d t=%a\n", what, kind_name[kind],
+            " %s %d t=%a, %s %d t=%a\n", what, kind_name[kind],
             r->o[0], r->o[1], r->o[2], r->d[0], r->d[1], r->d[2], tmin, tmax,
-            want, wt, got, gt);
+            a, want, wt, b, got, gt);
 }
 
 /* Shape of the tree, and the 8-byte node: the block kd_bytes returns is
@@ -739,7 +745,7 @@ static int check_nearest(const scene *s, const prims *p, const kd_tree *t,
     got = kd_nearest(t, p, r->o, r->d, (void *)r, skip, tmin, &got_t, c);
     if (*want == got && !memcmp(want_t, &got_t, sizeof(double))) return 1;
     show_mismatch(skip < 0 ? "nearest" : "nearest with skip", kind, r, tmin, tmax,
-                  *want, *want_t, got, got_t);
+                  "brute", *want, *want_t, "tree", got, got_t);
     return 0;
 }
 
@@ -755,20 +761,45 @@ static int check_any(const scene *s, const prims *p, const kd_tree *t,
     if (*want == (got >= 0) && (got < 0 || (got != skip && got < s->n
                                               && test_prim(s, got, r, tmin, tmax, &tg))))
         return 1;
-    show_mismatch(skip < 0 ? "any" : "any with skip", kind, r, tmin, tmax, *want, 0, got, 0);
+    show_mismatch(skip < 0 ? "any" : "any with skip", kind, r, tmin, tmax,
+                  "brute", *want, 0, "tree", got, 0);
+    return 0;
+}
+
+/* One query (nearest, or any with `any`) asked of the walk (kd_nearest,
+ * kd_any) and of the recursive reference: 1 if they give the same
+ * primitive, bitwise the same t, and the same steps and tests. */
+static int check_recursive(const prims *p, const kd_tree *t, const ray *r,
+                           int kind, int skip, double tmin, double tmax, int any)
+{
+    prim_counters cw = {0, 0, 0}, cr = {0, 0, 0};
+    double tw = tmax, tr = tmax;
+    char a[80], b[80];
+    int w = any ? kd_any(t, p, r->o, r->d, (void *)r, skip, tmin, tmax, &cw)
+                : kd_nearest(t, p, r->o, r->d, (void *)r, skip, tmin, &tw, &cw);
+    int k = kd_intersect_recursive(t, p, r->o, r->d, (void *)r, skip, tmin, &tr,
+                                   any, &cr);
+    if (w == k && !memcmp(&tw, &tr, sizeof tw) && cw.steps == cr.steps
+        && cw.tests == cr.tests)
+        return 1;
+    sprintf(a, "walk (%llu steps, %llu tests)", cw.steps, cw.tests);
+    sprintf(b, "recursive (%llu steps, %llu tests)", cr.steps, cr.tests);
+    show_mismatch(any ? "recursive any" : "recursive nearest", kind, r, tmin,
+                  tmax, a, w, tw, b, k, tr);
     return 0;
 }
 
 /* Every ray: kd_nearest.  Every other ray: kd_any.  Every 8th ray, once
  * more with its nearest primitive skipped (the surface a ray leaves, in
- * ray.c): nearest on odd rays, any on even ones. */
+ * ray.c): nearest on odd rays, any on even ones.  Each of these queries is
+ * also asked of the recursive reference (check_recursive). */
 static void check_rays(const scene *s, const prims *p, const kd_tree *t, long nrays)
 {
     box3 b;
     splits sp = get_splits(t);
     prim_counters c = {0, 0, 0};
     long k, bad_near = 0, bad_any = 0, bad_skip = 0, hits = 0, anys = 0, anyrays = 0;
-    long skips = 0;
+    long skips = 0, rec_near = 0, rec_any = 0, bad_rec_near = 0, bad_rec_any = 0;
     long per_kind[KINDS] = {0}, bad_kind[KINDS] = {0};
     char msg[600], *m = msg;
     clock_t start = clock();
@@ -782,10 +813,13 @@ static void check_rays(const scene *s, const prims *p, const kd_tree *t, long nr
         ok = check_nearest(s, p, t, &r, kind, -1, tmin, tmax, k, &want, &want_t, &c);
         hits += want >= 0;
         if (!ok) bad_near++, bad_kind[kind]++;
+        rec_near++, bad_rec_near += !check_recursive(p, t, &r, kind, -1, tmin, tmax, 0);
         if (k % 8 == 1 && want >= 0) {
             skips++;
             if (!check_nearest(s, p, t, &r, kind, want, tmin, tmax, k, &w2, &w2_t, &c))
                 bad_skip++, bad_kind[kind]++;
+            rec_near++;
+            bad_rec_near += !check_recursive(p, t, &r, kind, want, tmin, tmax, 0);
         }
         if (k % 2) continue;  /* kd_any on every other ray */
         anyrays++;
@@ -794,10 +828,12 @@ static void check_rays(const scene *s, const prims *p, const kd_tree *t, long nr
             skips++;
             if (!check_any(s, p, t, &r, kind, want, tmin, ta, k, &w2, &c))
                 bad_skip++, bad_kind[kind]++;
+            rec_any++, bad_rec_any += !check_recursive(p, t, &r, kind, want, tmin, ta, 1);
         }
         ok = check_any(s, p, t, &r, kind, -1, tmin, ta, k, &w2, &c);
         anys += w2;
         if (!ok) bad_any++, bad_kind[kind]++;
+        rec_any++, bad_rec_any += !check_recursive(p, t, &r, kind, -1, tmin, ta, 1);
     }
     m += sprintf(m, "%ld rays, %ld hit, %ld mismatches; %.2f steps and %.2f "
                  "tests per ray (brute force: %d); %.1f s; by kind:", nrays, hits,
@@ -813,6 +849,11 @@ static void check_rays(const scene *s, const prims *p, const kd_tree *t, long nr
     sprintf(msg, "%ld rays again with their nearest primitive skipped (nearest and any), "
             "%ld mismatches", skips, bad_skip);
     report(bad_skip == 0 && (skips > 0 || hits == 0), msg, s->name, "skip");
+    sprintf(msg, "kd_intersect_recursive against the walk on every query above: "
+            "%ld nearest, %ld mismatches; %ld any, %ld mismatches (same primitive, "
+            "bitwise the same t, same steps and tests)", rec_near, bad_rec_near,
+            rec_any, bad_rec_any);
+    report(bad_rec_near == 0 && bad_rec_any == 0, msg, s->name, "recursive");
     free(sp.axis), free(sp.pos);
 }
 
