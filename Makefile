@@ -3,6 +3,7 @@
 # make stress   longer runs than make test: more kd-tree rays, every SPD scene
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)
+# make spd      the seven SPD scenes at the benchmark's sizes, generated into scenes/spd/
 # make clean
 CC     ?= cc
 CFLAGS ?= -O2
@@ -10,7 +11,7 @@ LDLIBS  = -lm
 # OpenMP when the compiler has it (gcc, clang with libomp); ray.c builds without.
 OMP    := $(shell echo 'int main(void){return 0;}' | $(CC) -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
 
-PROGS = ray minray tools/ppmdiff
+PROGS = ray minray tools/ppmdiff tools/spd
 
 all: $(PROGS)
 
@@ -24,6 +25,17 @@ minray: minray.c
 tools/ppmdiff: tools/ppmdiff.c
 	$(CC) $(CFLAGS) -o $@ tools/ppmdiff.c $(LDLIBS)
 
+tools/spd: tools/spd.c
+	$(CC) $(CFLAGS) -o $@ tools/spd.c $(LDLIBS)
+
+SPD_SCENES = balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11
+spd: $(SPD_SCENES:%=scenes/spd/%.nff)
+
+# scenes/spd/tree_s11.nff is "tools/spd tree 11"; written whole or not at all
+scenes/spd/%.nff: tools/spd
+	@mkdir -p scenes/spd
+	tools/spd $(subst _s, ,$*) >$@.tmp && mv $@.tmp $@
+
 test: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/run.sh
 
@@ -34,7 +46,7 @@ bench: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash bench/run.sh
 
 clean:
-	rm -rf $(PROGS) build bench/out
+	rm -rf $(PROGS) build bench/out scenes/spd
 
-.PHONY: all test stress bench clean golf
+.PHONY: all test stress bench clean golf spd
 -include golf/golf.mk
