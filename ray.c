@@ -86,11 +86,13 @@
 #define _POSIX_C_SOURCE 200809L
 #define RAY_POSIX
 #endif
+#include <ctype.h>
 #include <errno.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdint.h>
 #include <string.h>
 #include <time.h>
 #ifdef RAY_POSIX
@@ -152,7 +154,17 @@ typedef struct {
     vec eye, right, up, fwd;  /* orthonormal frame */
     real tan_half;            /* tan(fov / 2); fov: horizontal, edge to edge */
     real anchor;              /* 0.5: samples centred on the pixel; 0: on its corner */
+    real hither;              /* near clip: nothing nearer than this plane is seen */
 } Camera;
+
+/* A light as the path tracer samples it (sample_light): a point light, an
+ * emitting sphere or triangle (object obj), or the sky: the background seen
+ * as a uniform radiance from every direction. */
+enum { POINT_LIGHT, SPHERE_LIGHT, TRIANGLE_LIGHT, SKY_LIGHT };
+typedef struct {
+    int type, obj;
+    vec pos, intensity;       /* a point light's place and intensity I (radiance: I / d^2) */
+} Emitter;
 
 typedef struct {
     Material *mat;  int nmat, capmat;
@@ -166,6 +178,17 @@ typedef struct {
     int w, h, depth;
     vec ambient, background;
     int cull;                 /* for triangles still to come: `sided 1` */
+    int integrator;           /* WHITTED or PATH */
+    int spp;                  /* samples per pixel the scene asks for (0: none said) */
+    int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
+    int roulette;             /* 1: Russian roulette ends paths */
+    int max_rays;             /* rays on a path at most (-d); 0: no bound but roulette */
+    unsigned seed;            /* --seed: which noise */
+    Emitter *emit;  int nemit;  /* the path tracer's lights */
+    int sky;                  /* the sky's light, or -1 */
+    real *emit_cdf;           /* emit_cdf[i]: chance of choosing one of lights 0..i */
+    int *emitter;             /* emitter[object]: its light, or -1 */
+    char warning[256];        /* said once when the path tracer starts, if set */
     int accel;                /* which structure finds hits: ACCEL_NONE or ACCEL_KD */
     kd_tree *kd;              /* the kd-tree, when accel is ACCEL_KD */
     prims prims;              /* how the structure sees the objects (prims.h) */
@@ -173,6 +196,12 @@ typedef struct {
 
 /* --accel none: every ray tests every object; kd: the kd-tree of kdtree.c. */
 enum { ACCEL_NONE, ACCEL_KD };
+
+/* Whitted's recursive ray tracing, or Kajiya's path tracing; and the path
+ * tracer's three estimators of the light at a point: by sampling the BSDF
+ * only, by next-event estimation, or by both weighed by MIS. */
+enum { WHITTED, PATH };
+enum { BSDF_ONLY, NEE, MIS };
 
 /* Objects are numbered spheres first, then cones, then triangles. */
 enum { SPHERE, CONE, TRIANGLE };
@@ -183,8 +212,9 @@ static int nobj(const Scene *s) { return s->nsph + s->ncone + s->ntri; }
  * A ray leaving a flat triangle, or a sphere outward, never meets that
  * surface again, yet it starts in the tree's cells that list it: skip spares
  * that test.  The tree leaves skip out itself (kd_nearest's skip); the loop
- * over every object checks it in hit_object. */
-typedef struct { vec o, d; int skip; } Ray;
+ * over every object checks it in hit_object.  tmin is 0 but for a camera
+ * with a near clip (hither): hits at t <= tmin do not count. */
+typedef struct { vec o, d; real tmin; int skip; } Ray;
 
 typedef struct {
     real t;
@@ -204,19 +234,32 @@ typedef struct {
     unsigned long long primary, shadow, reflected, refracted;
     unsigned long long queries, nearest, hits;  /* all queries; nearest-hit ones; their hits */
     unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
+    unsigned long long bounced, discarded;      /* path tracer: BSDF-sampled rays; bad samples */
     int threads;                                /* how many threads rendered */
 } Counts;
 
 /* A thread's working state, handed down every call that traces a ray, as
  * smallpt hands down its per-row seed; never a global.  It holds the
- * thread's counts and the shadow cache of any_hit(): the last blocker of
- * each of the first SHADOW_SLOTS lights (lights further on share the slots,
- * which costs cache hits but never changes an answer). */
+ * thread's counts, the shadow cache of any_hit() (the last blocker of each
+ * of the first SHADOW_SLOTS lights; lights further on share the slots,
+ * which costs cache hits but never changes an answer), and where the path
+ * tracer's random numbers stand. */
 #define SHADOW_SLOTS 8
 typedef struct {
     Counts count;
     int blocker[SHADOW_SLOTS];  /* light i's last blocker, or -1, in slot i % SHADOW_SLOTS */
+    unsigned long long key;     /* the path tracer's random numbers: which sample, */
+    unsigned dim;               /* and how many it has drawn (see random01) */
 } Worker;
+
+/* The image being made: bytes (for PPM), or floats (for PFM), row by row
+ * from the top-left, three channels a pixel. */
+typedef struct {
+    int w, h;
+    unsigned char *bytes;
+    float *floats;
+    int srgb;                 /* bytes: through the sRGB curve */
+} Image;
 
 /* ----------------------------------------------------------------- vectors */
 
@@ -266,11 +309,13 @@ static void box_union(double lo[3], double hi[3], const double lo2[3], const dou
  * below defines them in this order. */
 
 /* for each pixel */
-static void render_row(const Scene *s, int j, int spp, unsigned char *row, Worker *wk);
+static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
 static void sample_offset(int k, real anchor, real *dx, real *dy);
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
+static void put_pixel(Image *img, int i, int j, vec c);
 static unsigned char to_byte(real v);
+static real srgb(real v);
 
 /* RayTrace(R): Whitted's recursive ray tracing */
 static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
@@ -280,6 +325,35 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real 
 static int worth_tracing(real k, real weight, int depth);
 static vec reflect(vec d, vec n, real cosi);
 static int refract(vec d, vec n, real cosi, real eta, vec *t);
+
+/* L = Le + integral f L cos: Kajiya's path tracing */
+typedef struct Path Path;
+typedef struct Bsdf Bsdf;
+static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk);
+static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk);
+static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk);
+static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk);
+static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
+static vec sky(const Scene *s, vec d, const Path *path);
+static real power_heuristic(real a, real b);
+static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Worker *wk);
+static int choose_light(const Scene *s, real u);
+static real light_choice(const Scene *s, int l);
+static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *wi,
+                          real *dist, vec *Le, real *pdf);
+static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny);
+static int front_emits(const Scene *s, int i, vec ng, vec wo);
+static Bsdf bsdf_at(const Scene *s, const Hit *h, vec wo);
+static vec bsdf_eval(const Bsdf *b, vec wo, vec wi);
+static real bsdf_pdf(const Bsdf *b, vec wo, vec wi);
+static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf);
+static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos);
+static real fresnel(real cosi, real eta);
+static vec cosine_direction(vec n, real u1, real u2);
+static vec phong_direction(vec m, real shine, real u1, real u2);
+static vec from_local(vec n, real x, real y, real z);
+static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
+static real random01(Worker *wk);
 
 /* finding hits: the only code that knows an acceleration structure exists */
 static int nearest_hit(const Scene *s, Ray r, Hit *h, Worker *wk);
@@ -302,6 +376,8 @@ static void sphere_surface(const Sphere *sp, const Ray *r, real t, Hit *h);
 static void sphere_box(const Sphere *sp, double lo[3], double hi[3]);
 static int sphere_clip(const Sphere *sp, const double blo[3], const double bhi[3],
                        double lo[3], double hi[3]);
+static real sphere_sample(const Sphere *sp, vec x, real u, real v, vec *wi, real *dist);
+static real sphere_pdf(const Sphere *sp, vec x, vec y);
 static real hit_cone(const Cone *c, const Ray *r, real tmin);
 static void cone_surface(const Cone *c, const Ray *r, real t, Hit *h);
 static void cone_box(const Cone *c, double lo[3], double hi[3]);
@@ -311,20 +387,20 @@ static void triangle_surface(const Scene *s, const Triangle *tr, real u, real v,
 static void triangle_box(const Scene *s, const Triangle *tr, double lo[3], double hi[3]);
 static int triangle_clip(const Scene *s, const Triangle *tr, const double blo[3],
                          const double bhi[3], double lo[3], double hi[3]);
+static void triangle_sample(const Triangle *tr, real u, real v, vec *y, vec *ny);
+static real triangle_pdf(const Triangle *tr, real dist, real cosy);
 
 /* ---------------------------------------------------------- for each pixel */
 
 /* The lecture's "for each pixel", for one row of the image (rows are what
- * the threads share out: see render()). */
-static void render_row(const Scene *s, int j, int spp, unsigned char *row, Worker *wk)
+ * the threads share out: see render()).  Whitted's colour, or with the path
+ * tracer the radiance. */
+static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 {
     int i;
-    for (i = 0; i < s->w; i++) {
-        vec c = pixel_color(s, i, j, spp, wk);
-        row[3 * i] = to_byte(c.x);
-        row[3 * i + 1] = to_byte(c.y);
-        row[3 * i + 2] = to_byte(c.z);
-    }
+    for (i = 0; i < s->w; i++)
+        put_pixel(img, i, j, s->integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
+                                                   : pixel_color(s, i, j, spp, wk));
 }
 
 
@@ -367,7 +443,25 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
     r.skip = -1;
     r.d = unit(add(add(scale(x - (real)w / 2, c->right),
                        scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
+    r.tmin = c->hither > 0 ? c->hither / dot(r.d, c->fwd) : 0;
     return r;
+}
+
+/* The pixel into the image: as floats (for PFM, the radiance itself), or
+ * as bytes, through the sRGB curve where the image asks for it. */
+static void put_pixel(Image *img, int i, int j, vec c)
+{
+    size_t at = 3 * ((size_t)j * img->w + i);
+    if (img->floats) {
+        img->floats[at] = (float)c.x;
+        img->floats[at + 1] = (float)c.y;
+        img->floats[at + 2] = (float)c.z;
+        return;
+    }
+    if (img->srgb) c = v3(srgb(c.x), srgb(c.y), srgb(c.z));
+    img->bytes[at] = to_byte(c.x);
+    img->bytes[at + 1] = to_byte(c.y);
+    img->bytes[at + 2] = to_byte(c.z);
 }
 
 /* Colour in 0..1 to a byte: x255 and round to nearest (as minray's %.0f
@@ -377,6 +471,14 @@ static unsigned char to_byte(real v)
     double x = rint((double)v * 255);
     if (!(x > 0)) return 0;
     return x > 255 ? 255 : (unsigned char)x;
+}
+
+/* Linear radiance to the sRGB curve (IEC 61966-2-1), for a path-traced
+ * image on an ordinary display.  Whitted's images stay linear, as the card
+ * prints them. */
+static real srgb(real v)
+{
+    return v <= (real)0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
 }
 
 /* ------------------------------------------------------------- RayTrace(R) */
@@ -477,6 +579,473 @@ static int refract(vec d, vec n, real cosi, real eta, vec *t)
     return 1;
 }
 
+/* ------------------------------------------ L = Le + integral f L cos: Kajiya */
+
+/* The lecture's second half: the rendering equation (Kajiya, "The Rendering
+ * Equation", SIGGRAPH 1986).  The radiance leaving x towards wo is what x
+ * emits plus what it reflects of the radiance arriving from every wi:
+ *
+ *     L(x, wo) = Le(x, wo) + integral over wi of f(x, wi, wo) Li(x, wi) cos(theta_i)
+ *
+ * and Li(x, wi) is itself L at the nearest point seen from x along wi.
+ * Monte Carlo integration (Kalos and Whitlock 1986) estimates the integral
+ * from one random direction wi drawn with probability density pdf(wi):
+ *
+ *     integral ~= f(x, wi, wo) Li(x, wi) cos(theta_i) / pdf(wi)
+ *
+ * which is unbiased, and averaging many such estimates converges to L.
+ * Following the recursion gives one random path per sample: path tracing.
+ * Three ways to estimate the integral, chosen by --estimator:
+ *
+ *  1. BSDF sampling only (smallpt): wi drawn from the BSDF; light counts
+ *     only when a path happens to hit an emitter (never a point light).
+ *  2. Next-event estimation (NEE): at each bounce one shadow ray to a point
+ *     chosen on a light gives the direct light (sample_light); the BSDF's
+ *     direction then gathers only the indirect light.
+ *  3. Both, weighed by multiple importance sampling with the power
+ *     heuristic (Veach and Guibas, "Optimally Combining Sampling Techniques
+ *     for Monte Carlo Rendering", SIGGRAPH 1995): each estimate counts most
+ *     where its own pdf is the larger.  The default.
+ *
+ * Paths end by Russian roulette (Arvo and Kirk, "Particle Transport and
+ * Image Synthesis", SIGGRAPH 1990): after ROULETTE_FROM rays a path goes on
+ * with a probability q and its throughput is divided by q, so the mean is
+ * unchanged; or at -d rays. */
+#define ROULETTE_FROM 4
+#define MAX_PATH 1024       /* a bound on the recursion, as a guard: with roulette
+                             * a path reaches it with odds below 0.95^1000 */
+
+/* What radiance() knows of the path that led to its ray. */
+struct Path {
+    vec beta;               /* throughput: the share of this ray's radiance in the pixel */
+    int rays;               /* rays so far, this one included */
+    int counted;            /* 1: a light this ray meets counts in full (a camera ray,
+                             * or one from a mirror or glass, which NEE cannot find) */
+    real pdf;               /* else: the pdf with which the BSDF chose this ray */
+    vec from, n_from;       /* the point it left, and the normal there */
+};
+
+/* A BSDF at one hit: the card's weights as lobes.  kd*colour is a
+ * Lambertian albedo; ks is an ideal mirror, or, with a Phong exponent
+ * (NFF's materials), a glossy lobe; kt is a smooth dielectric of index ir.
+ * The weights are scaled down to sum to 1 where they sum to more (the card's
+ * glass ball has 1.1).  n and ng face the side wo comes from; eta is the
+ * ratio n1/n2 of the indices for a ray going through. */
+struct Bsdf {
+    vec n, ng;
+    vec albedo;             /* Lambertian: f = albedo / pi */
+    real glossy, shine;     /* modified Phong: f = glossy (shine+2)/(2 pi) cos^shine(alpha) */
+    real mirror;            /* ideal mirror (a delta lobe) */
+    real glass, eta;        /* smooth dielectric with Fresnel (delta lobes) */
+    real p[4];              /* the chance to sample each lobe: diffuse, glossy, mirror, glass */
+};
+enum { DIFFUSE_LOBE, GLOSSY_LOBE, MIRROR_LOBE, GLASS_LOBE };
+
+/* The pixel's radiance: the mean of spp paths through random points of
+ * it.  A sample that is not finite (from a degenerate scene) is counted
+ * and left out, so that no NaN reaches an image. */
+static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk)
+{
+    vec sum = v3(0, 0, 0), L;
+    int k;
+    for (k = 0; k < spp; k++) {
+        L = sample_radiance(s, i, j, k, wk);
+        if (isfinite(L.x) && isfinite(L.y) && isfinite(L.z)) sum = add(sum, L);
+        else wk->count.discarded++;
+    }
+    return scale((real)1 / spp, sum);
+}
+
+/* Sample k of pixel (i, j): the radiance along one camera ray through a
+ * random point of the pixel. */
+static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
+{
+    Path path;
+    real dx, dy;
+    start_sample(wk, s, i, j, k);
+    dx = random01(wk);
+    dy = random01(wk);
+    wk->count.primary++;
+    path.beta = v3(1, 1, 1);
+    path.rays = 1;
+    path.counted = 1;
+    return radiance(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), &path, wk);
+}
+
+/* L(x, wo) = Le(x, wo) + integral f Li cos, for the ray r arriving at x:
+ * the radiance it carries back, estimated by one random path. */
+static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
+{
+    Hit h;
+    Bsdf b;
+    Path next;
+    vec wo = scale(-1, r.d), Le, direct, f_cos, Li;
+    real pdf;
+    int lobe;
+    if (!nearest_hit(s, r, &h, wk)) return sky(s, r.d, path);
+    Le = emitted(s, &h, wo, path);
+    if (path->rays == s->max_rays || path->rays == MAX_PATH) return Le;
+    b = bsdf_at(s, &h, wo);
+    direct = s->estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
+    lobe = sample_bsdf(&b, wo, wk, &next.from, &f_cos, &pdf);   /* next.from: wi */
+    if (lobe < 0) return add(Le, direct);
+    next.beta = mul(path->beta, f_cos);
+    if (!survives(s, path->rays, &next.beta, &f_cos, wk)) return add(Le, direct);
+    wk->count.bounced++;
+    next.rays = path->rays + 1;
+    next.counted = lobe == MIRROR_LOBE || lobe == GLASS_LOBE;
+    next.pdf = pdf;
+    r = spawn(s, &h, next.from);
+    next.from = h.p;
+    next.n_from = b.n;
+    Li = radiance(s, r, &next, wk);
+    return add(add(Le, direct), mul(f_cos, Li));
+}
+
+/* Russian roulette: from ROULETTE_FROM rays on, the path goes on with the
+ * chance q that its throughput beta suggests (at most 0.95, so that a hall
+ * of mirrors ends too), and what it brings back counts 1/q times. */
+static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
+{
+    real q, m = beta->x > beta->y ? beta->x : beta->y;
+    if (m < beta->z) m = beta->z;
+    if (!s->roulette || rays < ROULETTE_FROM) return 1;
+    q = m < (real)0.95 ? m : (real)0.95;
+    if (!(random01(wk) < q)) return 0;
+    *beta = scale(1 / q, *beta);
+    *f_cos = scale(1 / q, *f_cos);
+    return 1;
+}
+
+/* Le: what the hit object emits towards wo (kl times its colour; a sphere
+ * from both sides, a one-sided triangle from its front only), weighed for
+ * the estimator: NEE has counted it already unless the ray came from the
+ * camera, a mirror or glass; MIS weighs it against sample_light's pdf. */
+static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path)
+{
+    const Material *m = &s->mat[h->mat];
+    real w = 1;
+    if (!(m->kl > 0) || !front_emits(s, h->obj, h->ng, wo)) return v3(0, 0, 0);
+    if (!path->counted && s->estimator == NEE) return v3(0, 0, 0);
+    if (!path->counted && s->estimator == MIS)
+        w = power_heuristic(path->pdf, light_pdf(s, s->emitter[h->obj], path->from,
+                                                 path->n_from, h->p, h->ng));
+    return scale(w * m->kl, m->color);
+}
+
+/* The background: a uniform radiance from every direction (the sky),
+ * weighed like any light. */
+static vec sky(const Scene *s, vec d, const Path *path)
+{
+    real w = 1;
+    if (!path->counted && s->estimator == NEE) return v3(0, 0, 0);
+    if (!path->counted && s->estimator == MIS && s->sky >= 0)
+        w = power_heuristic(path->pdf, light_pdf(s, s->sky, path->from, path->n_from, d, d));
+    return scale(w, s->background);
+}
+
+/* The power heuristic with exponent 2 (Veach and Guibas 1995): the weight
+ * of an estimate made with pdf a when another technique had pdf b. */
+static real power_heuristic(real a, real b)
+{
+    return a * a / (a * a + b * b);
+}
+
+/* Next-event estimation: the light reaching the hit directly from one light,
+ * chosen in proportion to its power, through a point chosen on it:
+ *
+ *     f(x, wi, wo) Le cos(theta_i) / pdf(wi)   if nothing lies between,
+ *
+ * weighed by MIS against the BSDF's own sampling of the same direction. */
+static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Worker *wk)
+{
+    vec wi, Le, f;
+    real dist, pdf, cosi;
+    int l = choose_light(s, random01(wk)), delta;
+    Ray r;
+    if (l < 0) return v3(0, 0, 0);
+    delta = sample_emitter(s, l, h->p, b->n, wk, &wi, &dist, &Le, &pdf);
+    if (!(pdf > 0)) return v3(0, 0, 0);
+    pdf *= light_choice(s, l);
+    cosi = dot(wi, b->n);
+    f = bsdf_eval(b, wo, wi);
+    if (!(cosi > 0) || (f.x == 0 && f.y == 0 && f.z == 0)) return v3(0, 0, 0);
+    wk->count.shadow++;
+    r = spawn(s, h, wi);
+    if (s->emit[l].type == SPHERE_LIGHT || s->emit[l].type == TRIANGLE_LIGHT)
+        r.skip = s->emit[l].obj;          /* the light itself does not block */
+    if (any_hit(s, r, dist, &wk->blocker[l % SHADOW_SLOTS], wk)) return v3(0, 0, 0);
+    if (!delta && s->estimator == MIS) pdf /= power_heuristic(pdf, bsdf_pdf(b, wo, wi));
+    return scale(cosi / pdf, mul(f, Le));
+}
+
+/* The light whose share of the total power holds u, or -1 without lights. */
+static int choose_light(const Scene *s, real u)
+{
+    int lo = 0, hi = s->nemit - 1;
+    if (s->nemit == 0) return -1;
+    while (lo < hi) {               /* the first light whose cdf exceeds u */
+        int mid = (lo + hi) / 2;
+        if (s->emit_cdf[mid] > u) hi = mid;
+        else lo = mid + 1;
+    }
+    return lo;
+}
+
+/* The chance that choose_light picks light l. */
+static real light_choice(const Scene *s, int l)
+{
+    return s->emit_cdf[l] - (l > 0 ? s->emit_cdf[l - 1] : 0);
+}
+
+/* A direction wi from x towards a point of light l, the distance dist to
+ * that point (INFINITY for the sky), the radiance Le it sends back along
+ * -wi, and the pdf of wi in solid angle.  Returns 1 for a point light,
+ * which only this can find (its pdf is the choice alone). */
+static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *wi,
+                          real *dist, vec *Le, real *pdf)
+{
+    const Emitter *e = &s->emit[l];
+    const Material *m;
+    real u = random01(wk), v = random01(wk);
+    vec y, ny;
+    int k;
+    *pdf = 0;
+    if (e->type == POINT_LIGHT) {
+        vec d = sub(e->pos, x);
+        *dist = sqrt(dot(d, d));
+        *wi = scale(1 / *dist, d);
+        *Le = scale(1 / (*dist * *dist), e->intensity);
+        *pdf = 1;
+        return 1;
+    }
+    if (e->type == SKY_LIGHT) {
+        *wi = cosine_direction(n, u, v);
+        *dist = INFINITY;
+        *Le = s->background;
+        *pdf = dot(*wi, n) / (real)PI;
+        return 0;
+    }
+    kind(s, e->obj, &k);
+    if (e->type == SPHERE_LIGHT) {
+        *pdf = sphere_sample(&s->sph[k], x, u, v, wi, dist);
+        m = &s->mat[s->sph[k].mat];
+    } else {
+        triangle_sample(&s->tri[k], u, v, &y, &ny);
+        *dist = sqrt(dot(sub(y, x), sub(y, x)));
+        *wi = scale(1 / *dist, sub(y, x));
+        *pdf = triangle_pdf(&s->tri[k], *dist, dot(*wi, ny));
+        m = &s->mat[s->tri[k].mat];
+        if (!front_emits(s, e->obj, ny, scale(-1, *wi))) *pdf = 0;
+    }
+    *Le = scale(m->kl, m->color);
+    return 0;
+}
+
+/* The pdf (in solid angle at x, choice included) with which sample_light
+ * would have picked the point y, of normal ny, on light l: what MIS needs
+ * for a light found by BSDF sampling.  For the sky, y is the direction. */
+static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny)
+{
+    const Emitter *e = &s->emit[l];
+    vec d;
+    real dist;
+    int k;
+    if (e->type == SKY_LIGHT) return light_choice(s, l) * fmax(0, dot(y, n)) / (real)PI;
+    kind(s, e->obj, &k);
+    if (e->type == SPHERE_LIGHT) return light_choice(s, l) * sphere_pdf(&s->sph[k], x, y);
+    d = sub(y, x);
+    dist = sqrt(dot(d, d));
+    return light_choice(s, l) * triangle_pdf(&s->tri[k], dist, dot(d, ny) / dist);
+}
+
+/* Whether object i, with front normal ng, emits towards wo: a one-sided
+ * triangle only from its front. */
+static int front_emits(const Scene *s, int i, vec ng, vec wo)
+{
+    int k;
+    return kind(s, i, &k) != TRIANGLE || !s->tri[k].cull || dot(wo, ng) > 0;
+}
+
+/* The BSDF at a hit, for light leaving towards wo. */
+static Bsdf bsdf_at(const Scene *s, const Hit *h, vec wo)
+{
+    const Material *m = &s->mat[h->mat];
+    real sum = m->kd + m->ks + m->kt, k = sum > 1 ? 1 / sum : 1, total;
+    Bsdf b;
+    int i;
+    b.n = h->n;
+    b.ng = h->ng;
+    b.eta = 1 / m->ir;
+    if (dot(wo, h->ng) < 0) {             /* inside: the ray goes out */
+        b.n = scale(-1, b.n);
+        b.ng = scale(-1, b.ng);
+        b.eta = m->ir;
+    }
+    b.albedo = scale(k * m->kd, m->color);
+    b.shine = m->shine;
+    b.glossy = m->shine > 0 ? k * m->ks : 0;
+    b.mirror = m->shine > 0 ? 0 : k * m->ks;
+    b.glass = k * m->kt;
+    b.p[DIFFUSE_LOBE] = fmax(b.albedo.x, fmax(b.albedo.y, b.albedo.z));
+    b.p[GLOSSY_LOBE] = b.glossy;
+    b.p[MIRROR_LOBE] = b.mirror;
+    b.p[GLASS_LOBE] = b.glass;
+    total = b.p[0] + b.p[1] + b.p[2] + b.p[3];
+    for (i = 0; i < 4; i++) b.p[i] = total > 0 ? b.p[i] / total : 0;
+    return b;
+}
+
+/* f(x, wi, wo) for the lobes that are not deltas (Lambert and Phong).  Zero
+ * unless wi and wo lie on the same side of the surface, by both normals. */
+static vec bsdf_eval(const Bsdf *b, vec wo, vec wi)
+{
+    vec f = scale(1 / (real)PI, b->albedo);
+    if (!(dot(wi, b->ng) > 0 && dot(wi, b->n) > 0)) return v3(0, 0, 0);
+    if (b->glossy > 0) {
+        real c = fmax(0, dot(wi, reflect(scale(-1, wo), b->n, dot(wo, b->n))));
+        real g = b->glossy * (b->shine + 2) / (2 * (real)PI) * pow(c, b->shine);
+        f = add(f, v3(g, g, g));
+    }
+    return f;
+}
+
+/* The pdf with which sample_bsdf draws wi, for the lobes that are not
+ * deltas: cosine-weighted for Lambert, cos^shine about the mirror
+ * direction for Phong. */
+static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
+{
+    real cosi = dot(wi, b->n), pdf;
+    if (!(cosi > 0 && dot(wi, b->ng) > 0)) return 0;
+    pdf = b->p[DIFFUSE_LOBE] * cosi / (real)PI;
+    if (b->glossy > 0) {
+        real c = fmax(0, dot(wi, reflect(scale(-1, wo), b->n, dot(wo, b->n))));
+        pdf += b->p[GLOSSY_LOBE] * (b->shine + 1) / (2 * (real)PI) * pow(c, b->shine);
+    }
+    return pdf;
+}
+
+/* Draws wi from the BSDF: first a lobe, by the chances p, then a
+ * direction from it.  *f_cos returns f cos(theta_i) / pdf, the factor the
+ * light from wi is multiplied by; *pdf the pdf of wi (for MIS; undefined for
+ * a delta lobe).  Returns the lobe, or -1 when the path ends here (the
+ * light is absorbed, or the direction fell below the surface). */
+static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf)
+{
+    real u = random01(wk), u1 = random01(wk), u2 = random01(wk), cosi = dot(wo, b->n);
+    int lobe = 0;
+    *pdf = 0;
+    while (lobe < GLASS_LOBE && u >= b->p[lobe]) u -= b->p[lobe++];
+    if (!(b->p[lobe] > 0)) return -1;
+    if (lobe == MIRROR_LOBE) {
+        *wi = reflect(scale(-1, wo), b->n, cosi);
+        *f_cos = v3(b->mirror / b->p[lobe], b->mirror / b->p[lobe], b->mirror / b->p[lobe]);
+        return dot(*wi, b->ng) > 0 ? lobe : -1;
+    }
+    if (lobe == GLASS_LOBE) return sample_glass(b, wo, u / b->p[lobe], wi, f_cos);
+    if (lobe == DIFFUSE_LOBE) *wi = cosine_direction(b->n, u1, u2);
+    else *wi = phong_direction(reflect(scale(-1, wo), b->n, cosi), b->shine, u1, u2);
+    *pdf = bsdf_pdf(b, wo, *wi);
+    if (!(*pdf > 0)) return -1;
+    *f_cos = scale(dot(*wi, b->n) / *pdf, bsdf_eval(b, wo, *wi));
+    return lobe;
+}
+
+/* The smooth dielectric: reflect with the Fresnel reflectance F, else
+ * refract (Snell, as Whitted's refract()).  Each is chosen with its own
+ * chance, so the weight is the lobe's alone, times eta^2 through the
+ * surface: radiance is crowded into a narrower cone entering a denser
+ * medium, and spreads out leaving it (the same factor, inverted, so a
+ * path in and out again gets the two back to 1). */
+static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos)
+{
+    real cosi = dot(wo, b->n), w = b->glass / b->p[GLASS_LOBE];
+    vec d = scale(-1, wo);
+    if (u < fresnel(cosi, b->eta) || !refract(d, b->n, cosi, b->eta, wi)) {
+        *wi = reflect(d, b->n, cosi);
+        *f_cos = v3(w, w, w);
+        return dot(*wi, b->ng) > 0 ? GLASS_LOBE : -1;
+    }
+    w *= b->eta * b->eta;
+    *f_cos = v3(w, w, w);
+    return dot(*wi, b->ng) < 0 ? GLASS_LOBE : -1;
+}
+
+/* The Fresnel reflectance of unpolarised light at a smooth dielectric
+ * surface: the mean of the s and p polarisations' equations, exact (Born
+ * and Wolf, Principles of Optics, 1.5.2).  cosi is the cosine of the angle
+ * of incidence, eta = n1/n2; 1 on total internal reflection.  Exact
+ * rather than Schlick's approximation (which smallpt uses): the cost is a
+ * square root at glass, and a glass ball in a white room then vanishes
+ * exactly, which a test checks. */
+static real fresnel(real cosi, real eta)
+{
+    real sin2t = eta * eta * (1 - cosi * cosi), cost, rs, rp;
+    if (sin2t >= 1) return 1;
+    cost = sqrt(1 - sin2t);
+    rs = (eta * cosi - cost) / (eta * cosi + cost);
+    rp = (cosi - eta * cost) / (cosi + eta * cost);
+    return (rs * rs + rp * rp) / 2;
+}
+
+/* A direction about the unit vector n with pdf cos(theta)/pi (Malley's
+ * method: a uniform point of the unit disc, lifted onto the hemisphere). */
+static vec cosine_direction(vec n, real u1, real u2)
+{
+    real r = sqrt(u1), phi = 2 * (real)PI * u2;
+    return from_local(n, r * cos(phi), r * sin(phi), sqrt(fmax(0, 1 - u1)));
+}
+
+/* A direction about the unit vector m with pdf (shine+1)/(2 pi) cos^shine
+ * of the angle to m: the lobe of the modified Phong BRDF (Lafortune and
+ * Willems, "Using the modified Phong reflectance model for physically based
+ * rendering", 1994). */
+static vec phong_direction(vec m, real shine, real u1, real u2)
+{
+    real c = pow(u1, 1 / (shine + 1)), s = sqrt(fmax(0, 1 - c * c)), phi = 2 * (real)PI * u2;
+    return from_local(m, s * cos(phi), s * sin(phi), c);
+}
+
+/* x t1 + y t2 + z n for an orthonormal t1, t2 made from the unit vector n
+ * (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017). */
+static vec from_local(vec n, real x, real y, real z)
+{
+    real sign = n.z >= 0 ? 1 : -1, a = -1 / (sign + n.z), b = n.x * n.y * a;
+    vec t1 = v3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    vec t2 = v3(b, sign + n.y * n.y * a, -n.y);
+    return add(add(scale(x, t1), scale(y, t2)), scale(z, n));
+}
+
+/* Random numbers without a generator's state: the n-th number of sample k
+ * of pixel p is a hash of (seed, p, k, n).  So a pixel's noise does not
+ * depend on which thread computes it, nor on the order, and any part of an
+ * image can be rendered apart and put together exactly.  (smallpt seeds a
+ * generator per row with y^3 cut to 16 bits, which gives rows 0, 64,
+ * 128, ... the same noise.)  The hash is the finaliser of SplitMix64
+ * (Steele, Lea and Flood, "Fast splittable pseudorandom number generators",
+ * OOPSLA 2014), applied once per key and once per number. */
+static unsigned long long mix64(unsigned long long z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+static void start_sample(Worker *wk, const Scene *s, int i, int j, int k)
+{
+    unsigned long long pixel = (unsigned long long)j * (unsigned)s->w + (unsigned)i;
+    wk->key = mix64(mix64(mix64(s->seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
+    wk->dim = 0;
+}
+
+/* The next random number of the sample, uniform in [0, 1). */
+static real random01(Worker *wk)
+{
+    unsigned long long h = mix64(wk->key + 0x9e3779b97f4a7c15ULL * ++wk->dim);
+    real u = (real)((h >> 11) * (1.0 / 9007199254740992.0));
+    return u < 1 ? u : 1 - REAL_EPS;      /* a float may round up to 1 */
+}
+
 /* ------------------------------------------------------------ finding hits */
 
 /* The lecture's "find the nearest hit" (t, point, object, normal).
@@ -514,7 +1083,7 @@ static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk)
         prim_counters c = { 0, 0, 0 };
         to3(q->r.o, o);
         to3(q->r.d, d);
-        best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, 0, &tmax, &c);
+        best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
         *t = (real)tmax;
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
@@ -567,8 +1136,8 @@ static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
     int k;
     if (i == r->skip) return 0;
     switch (kind(s, i, &k)) {
-    case SPHERE: *t = hit_sphere(&s->sph[k], r, 0); break;
-    case CONE: *t = hit_cone(&s->cone[k], r, 0); break;
+    case SPHERE: *t = hit_sphere(&s->sph[k], r, r->tmin); break;
+    case CONE: *t = hit_cone(&s->cone[k], r, r->tmin); break;
     default: return hit_triangle(s, &s->tri[k], r, tmax, t, &u, &v);
     }
     return *t <= tmax && *t < INFINITY;         /* INFINITY is a miss */
@@ -606,6 +1175,7 @@ static Ray spawn(const Scene *s, const Hit *h, vec dir)
     Ray r;
     r.o = comb(out ? eps : -eps, h->ng, h->p);
     r.d = dir;
+    r.tmin = 0;
     r.skip = what == TRIANGLE || (what == SPHERE && out) ? h->obj : -1;
     return r;
 }
@@ -647,7 +1217,7 @@ static int find_any(const Scene *s, Query *q, real tmax, Worker *wk)
         int hit;
         to3(q->r.o, o);
         to3(q->r.d, d);
-        hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, 0, tmax, &c);
+        hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
         return hit;
@@ -764,6 +1334,50 @@ static int sphere_clip(const Sphere *sp, const double blo[3], const double bhi[3
         if (!(lo[a] <= hi[a])) return 0;
     }
     return 1;
+}
+
+/* For a sphere that emits: a direction wi from x towards it, and the
+ * distance to the point of the sphere it meets; returns the pdf of wi in
+ * solid angle.  From outside, wi is uniform in the cone of directions the
+ * sphere fills as seen from x, so that every sample hits it, and the near
+ * side is what is hit (Shirley, Wang and Zimmerman, "Monte Carlo Techniques
+ * for Direct Lighting Calculations", ACM TOG 15(1), 1996).  From inside, or
+ * on the surface (a furnace seen from within), wi points to a uniform point
+ * of the surface, and the pdf is that of the area turned into solid angle:
+ * dist^2 / (A cos theta_y), the lecture's d omega = dA cos theta / r^2. */
+static real sphere_sample(const Sphere *sp, vec x, real u, real v, vec *wi, real *dist)
+{
+    vec dc = sub(sp->cen, x), n;
+    real d2 = dot(dc, dc), r2 = sp->rad * sp->rad, z, rr, phi;
+    if (d2 > r2 * (1 + 64 * REAL_EPS)) {
+        real d = sqrt(d2), sin2max = r2 / d2;
+        real cap = sin2max / (1 + sqrt(1 - sin2max));     /* 1 - cos(theta_max), no cancelling */
+        real c = 1 - u * cap, s2 = fmax(0, 1 - c * c);
+        phi = 2 * (real)PI * v;
+        *wi = from_local(scale(1 / d, dc), sqrt(s2) * cos(phi), sqrt(s2) * sin(phi), c);
+        *dist = d * c - sqrt(fmax(0, r2 - d2 * s2));
+        return 1 / (2 * (real)PI * cap);
+    }
+    z = 1 - 2 * u;
+    rr = sqrt(fmax(0, 1 - z * z));
+    phi = 2 * (real)PI * v;
+    n = v3(rr * cos(phi), rr * sin(phi), z);
+    dc = sub(comb(sp->rad, n, sp->cen), x);
+    *dist = sqrt(dot(dc, dc));
+    *wi = scale(1 / *dist, dc);
+    return sphere_pdf(sp, x, comb(sp->rad, n, sp->cen));
+}
+
+/* The pdf with which sphere_sample, from x, picks the direction to y, a
+ * point of the sphere (the one a ray from x met first). */
+static real sphere_pdf(const Sphere *sp, vec x, vec y)
+{
+    vec dc = sub(sp->cen, x), d = sub(y, x);
+    real d2 = dot(dc, dc), r2 = sp->rad * sp->rad, dist2 = dot(d, d), cosy;
+    if (d2 > r2 * (1 + 64 * REAL_EPS))
+        return 1 / (2 * (real)PI * (r2 / d2 / (1 + sqrt(1 - r2 / d2))));
+    cosy = fabs(dot(sub(y, sp->cen), d)) / (sp->rad * sqrt(dist2));
+    return dist2 / (4 * (real)PI * r2 * cosy);
 }
 
 /* --------------------------------------------------- the primitives: cones */
@@ -933,7 +1547,7 @@ static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real t
     if ((uu < 0 || vv < 0 || uu + vv > det)
         && !watertight_inside(v0, s->vert[tr->v[1]], s->vert[tr->v[2]], r)) return 0;
     *t = tt / det;      /* compared after the division: a tie at tmax must be exact */
-    if (!(*t <= tmax)) return 0;
+    if (!(*t <= tmax) || (r->tmin > 0 && !(*t > r->tmin))) return 0;
     *u = uu / det;
     *v = vv / det;
     return 1;
@@ -1010,6 +1624,24 @@ static int triangle_clip(const Scene *s, const Triangle *tr, const double blo[3]
     return 1;
 }
 
+/* For a triangle that emits: a uniform point y of it, and its front normal
+ * (Turk, "Generating random points in triangles", Graphics Gems, 1990). */
+static void triangle_sample(const Triangle *tr, real u, real v, vec *y, vec *ny)
+{
+    real su = sqrt(u);
+    *y = add(tr->v0, add(scale(su * (1 - v), tr->e1), scale(su * v, tr->e2)));
+    *ny = unit(cross(tr->e1, tr->e2));
+}
+
+/* The pdf in solid angle of a uniform point of the triangle seen at
+ * distance dist, its normal at cosine cosy to the line of sight:
+ * dist^2 / (A cos theta_y). */
+static real triangle_pdf(const Triangle *tr, real dist, real cosy)
+{
+    vec n = cross(tr->e1, tr->e2);
+    return dist * dist / (sqrt(dot(n, n)) / 2 * fabs(cosy));
+}
+
 /* Zero area (a repeated vertex, or three in a line) to within rounding: such
  * a triangle has no inside and no normal, so it is never hit.  Relative to
  * the edge lengths, so that tiny but proper triangles stay. */
@@ -1063,6 +1695,8 @@ static void add_counts(Counts *to, const Counts *from)
     to->steps += from->steps;
     to->queries += from->queries;
     to->nearest += from->nearest;
+    to->bounced += from->bounced;
+    to->discarded += from->discarded;
     if (from->threads > to->threads) to->threads = from->threads;
 }
 
@@ -1070,7 +1704,7 @@ static void add_counts(Counts *to, const Counts *from)
  * time, as they free up; each pixel is written once by whoever computes it,
  * so the image does not depend on the order.  Each thread has its own
  * Worker; their counts are summed into *total. */
-static void render(const Scene *s, const Options *o, unsigned char *img, Counts *total)
+static void render(const Scene *s, const Options *o, Image *img, Counts *total)
 {
     int done = 0;
 #ifdef _OPENMP
@@ -1091,7 +1725,7 @@ static void render(const Scene *s, const Options *o, unsigned char *img, Counts 
             /* a row starts with an empty shadow cache, so that the counts
              * do not depend on which thread had the row before */
             for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
-            render_row(s, j, o->spp, img + 3 * (size_t)j * s->w, &wk);
+            render_row(s, j, o->spp, img, &wk);
             OMP(omp atomic capture)
             mine = ++done;
             if (o->progress && (mine * 100 / s->h != (mine - 1) * 100 / s->h))
@@ -1165,6 +1799,9 @@ static void add_light(Scene *s, vec pos, vec color, int sphere)
     s->nlight++;
 }
 
+/* The path tracer scales kd + ks + kt down to 1 where they sum to more,
+ * which would make light out of nothing; the first such material is named
+ * in a warning when it starts. */
 static int add_material(Scene *s, Material m)
 {
     s->mat = grow(s->mat, &s->capmat, s->nmat + 1, sizeof *s->mat);
@@ -1340,6 +1977,15 @@ static int check_cone(Scene *s, Where w, const real *x, int mat)
     return 1;
 }
 
+/* Remembers the first material whose kd + ks + kt exceeds 1, for the path
+ * tracer's warning (Whitted's model takes such weights as they are). */
+static void note_weights(Scene *s, Where w, const Material *m)
+{
+    if (m->kd + m->ks + m->kt > 1 && !s->warning[0])
+        sprintf(s->warning, "%.100s:%d: warning: kd + ks + kt = %.3g exceeds 1; "
+                "the path tracer scales them to 1", w.file, w.line, (double)(m->kd + m->ks + m->kt));
+}
+
 /* r g b kd ks kt kl ir: minray's material fields, for tri and mesh lines. */
 static int material8(Scene *s, Where w, const real *v, int *mat)
 {
@@ -1348,8 +1994,10 @@ static int material8(Scene *s, Where w, const real *v, int *mat)
     m.color = v3(v[0], v[1], v[2]);
     m.kd = v[3]; m.ks = v[4]; m.kt = v[5]; m.kl = v[6]; m.ir = v[7]; m.shine = 0;
     *mat = add_material(s, m);
+    note_weights(s, w, &m);
     return 1;
 }
+
 
 /* One sphere: minray's 12 numbers in minray's order. */
 static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
@@ -1530,7 +2178,26 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
         if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
         if (!(v[0] >= 1 && v[0] <= 64 && v[0] == floor(v[0])))
             return fail(w, "depth must be a whole number from 1 to 64", tok[1]);
-        s->depth = (int)v[0];
+        s->depth = s->max_rays = (int)v[0];
+        return 1;
+    }
+    if (!strcmp(k, "samples")) {
+        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
+        if (!(v[0] >= 1 && v[0] <= 1 << 20 && v[0] == floor(v[0])))
+            return fail(w, "samples must be a whole number from 1 to 1048576", tok[1]);
+        s->spp = (int)v[0];
+        return 1;
+    }
+    if (!strcmp(k, "hither")) {
+        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
+        if (!(v[0] >= 0)) return fail(w, "hither must be 0 or more", tok[1]);
+        s->cam.hither = v[0];
+        return 1;
+    }
+    if (!strcmp(k, "integrator")) {
+        if (ntok != 2 || (strcmp(tok[1], "path") && strcmp(tok[1], "whitted")))
+            return fail(w, "expected `integrator path` or `integrator whitted`", NULL);
+        s->integrator = !strcmp(tok[1], "path") ? PATH : WHITTED;
         return 1;
     }
     if (!strcmp(k, "ambient")) {
@@ -1595,7 +2262,72 @@ static void default_scene(Scene *s)
     s->w = s->h = 512;
     s->depth = 5;
     s->cam.anchor = (real)0.5;
+    s->integrator = WHITTED;
+    s->estimator = MIS;
+    s->roulette = 1;
+    s->sky = -1;
     set_camera(s, nowhere, v);
+}
+
+/* Luminance of a linear sRGB colour (ITU-R BT.709 weights). */
+static real luminance(vec c) { return (real)0.2126 * c.x + (real)0.7152 * c.y + (real)0.0722 * c.z; }
+
+static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, real power,
+                        double *total, int *cap)
+{
+    s->emit = grow(s->emit, cap, s->nemit + 1, sizeof *s->emit);
+    s->emit_cdf = realloc(s->emit_cdf, (size_t)*cap * sizeof *s->emit_cdf);
+    if (!s->emit_cdf) out_of_memory();
+    s->emit[s->nemit].type = type;
+    s->emit[s->nemit].obj = obj;
+    s->emit[s->nemit].pos = pos;
+    s->emit[s->nemit].intensity = intensity;
+    *total += power;
+    s->emit_cdf[s->nemit++] = (real)*total;
+    if (obj >= 0) s->emitter[obj] = s->nemit - 1;
+}
+
+/* The path tracer's lights, each with its power, so that sample_light can
+ * choose one in proportion to it: point lights (intensity I: power 4 pi I),
+ * emitting spheres and triangles (radiance Le over area A, each side:
+ * pi Le A).  A background that is not black is the sky, whose power has no
+ * finite measure: it is chosen half the time when there are other lights
+ * (pricing it by a sphere about the scene, as pbrt does, starves a small
+ * lamp on a large floor of shadow rays). */
+static void prepare_lights(Scene *s)
+{
+    double total = 0;
+    int i, k, cap = 0, n = nobj(s);
+    s->emitter = malloc(((size_t)n + 1) * sizeof *s->emitter);
+    if (!s->emitter) out_of_memory();
+    for (i = 0; i < n; i++) s->emitter[i] = -1;
+    s->sky = -1;
+    for (i = 0; i < s->nlight; i++)
+        if (s->light[i].sphere < 0)
+            add_emitter(s, POINT_LIGHT, -1, s->light[i].pos, s->light[i].color,
+                        4 * (real)PI * luminance(s->light[i].color), &total, &cap);
+    for (i = 0; i < n; i++) {
+        const Material *m;
+        int what = kind(s, i, &k);
+        real area;
+        if (what == CONE) continue;          /* cones glow but do not light */
+        m = &s->mat[what == SPHERE ? s->sph[k].mat : s->tri[k].mat];
+        if (!(m->kl > 0) || (what == TRIANGLE && s->tri[k].degenerate)) continue;
+        if (what == SPHERE) area = 4 * (real)PI * s->sph[k].rad * s->sph[k].rad;
+        else {
+            vec c = cross(s->tri[k].e1, s->tri[k].e2);
+            area = sqrt(dot(c, c)) / 2 * (s->tri[k].cull ? 1 : 2);
+        }
+        add_emitter(s, what == SPHERE ? SPHERE_LIGHT : TRIANGLE_LIGHT, i, v3(0, 0, 0),
+                    v3(0, 0, 0), (real)PI * m->kl * luminance(m->color) * area, &total, &cap);
+    }
+    if (luminance(s->background) > 0) {
+        s->sky = s->nemit;
+        add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), total > 0 ? (real)total : 1,
+                    &total, &cap);
+    }
+    for (i = 0; i < s->nemit; i++) s->emit_cdf[i] = total > 0 ? s->emit_cdf[i] / (real)total : 0;
+    if (s->nemit > 0) s->emit_cdf[s->nemit - 1] = 1;
 }
 
 /* The sphere format: a line of numbers is a sphere, a line that starts with
@@ -1680,6 +2412,7 @@ static int nff_view(Scene *s, Lexer *lx)
     if (!(x[3][0] > 0 && x[3][0] < 180))
         return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
     for (k = 0; k < 9; k++) v[k] = x[k / 3][k % 3];   /* from, at, up */
+    if (x[4][0] > 0) s->cam.hither = x[4][0];
     v[9] = 2 * atan(tan(x[3][0] * PI / 360) * s->w / (s->w > 1 ? s->w - 1 : 1)) * 180 / PI;
     return set_camera(s, lx->w, v);
 }
@@ -1741,6 +2474,7 @@ static int nff_material(Scene *s, Lexer *lx, int *mat)
     m.kd = x[3]; m.ks = x[4]; m.shine = x[5]; m.kt = x[6]; m.kl = 0;
     m.ir = x[7] > 0 ? x[7] : 1;  /* the SPD files write 0 for opaque materials */
     *mat = add_material(s, m);
+    note_weights(s, lx->w, &m);
     return 1;
 }
 
@@ -1856,16 +2590,38 @@ static void discard_output(Output *o)
     free(o->tmp);
 }
 
-static int write_ppm(Output *o, const unsigned char *img, int w, int h, int plain)
+static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain)
 {
     size_t i, n = (size_t)w * h * 3;
-    int ok;
-    fprintf(o->f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
+    fprintf(f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
     if (plain)
-        for (i = 0; i < n; i += 3) fprintf(o->f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
+        for (i = 0; i < n; i += 3) fprintf(f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
     else
-        fwrite(img, 1, n, o->f);
-    ok = fflush(o->f) == 0 && !ferror(o->f);
+        fwrite(img, 1, n, f);
+}
+
+/* PFM, netpbm's floating-point format: "PF" (colour), the size, and -1 for
+ * little-endian floats; then the rows from the bottom up. */
+static void write_pfm(FILE *f, const Image *img)
+{
+    int i, j, c;
+    fprintf(f, "PF\n%d %d\n-1.0\n", img->w, img->h);
+    for (j = img->h - 1; j >= 0; j--)
+        for (i = 0; i < 3 * img->w; i++) {
+            float x = img->floats[(size_t)j * 3 * img->w + i];
+            uint32_t u;
+            unsigned char b[4];
+            memcpy(&u, &x, 4);
+            for (c = 0; c < 4; c++) b[c] = (unsigned char)(u >> 8 * c);
+            fwrite(b, 1, 4, f);
+        }
+}
+
+/* Finishes an output: flushed and closed, and the temporary file renamed
+ * over the name asked for. */
+static int close_output(Output *o)
+{
+    int ok = fflush(o->f) == 0 && !ferror(o->f);
     if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
     if (ok && o->tmp) ok = rename(o->tmp, o->name) == 0;
     if (!ok) {
@@ -1876,18 +2632,36 @@ static int write_ppm(Output *o, const unsigned char *img, int w, int h, int plai
     return ok;
 }
 
+/* The image as PPM (bytes: binary P6, or plain P3), or as PFM (floats). */
+static int write_image(Output *o, const Image *img, int plain)
+{
+    if (img->floats) write_pfm(o->f, img);
+    else write_ppm(o->f, img->bytes, img->w, img->h, plain);
+    return close_output(o);
+}
+
 /* ------------------------------------------------------------ command line */
 
 static void usage(FILE *to)
 {
     fputs("usage: ray [options] SCENE\n"
-          "Renders SCENE with Whitted ray tracing: the sphere format (README.md), or\n"
-          "NFF (Eric Haines' Neutral File Format, the SPD scenes') when it ends .nff.\n"
-          "  -o FILE    output PPM (default: SCENE's base name + .ppm; - for stdout)\n"
+          "Renders SCENE with Whitted ray tracing, or path tracing (--pt): the sphere\n"
+          "format (README.md), or NFF (Eric Haines' Neutral File Format, the SPD\n"
+          "scenes') when it ends .nff.\n"
+          "  -o FILE    output image: PPM, or PFM (floats) when it ends .pfm\n"
+          "             (default: SCENE's base name + .ppm; - for stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
-          "  -n N       anti-aliasing samples per pixel (default 1)\n"
-          "  -d N       recursion depth, 1 = primary rays only (default: scene's, else 5)\n"
+          "  -n N       samples per pixel (default: the scene's `samples`, else 1)\n"
+          "  -d N       Whitted: recursion depth, 1 = primary rays only (default: the\n"
+          "             scene's, else 5); path tracing: rays a path may have (default:\n"
+          "             the scene's `depth`, else no bound but Russian roulette)\n"
           "  -t N       threads (default: all cores, when built with OpenMP)\n"
+          "  --pt       path tracing (Kajiya's rendering equation); --whitted: Whitted's\n"
+          "             (default: the scene's `integrator`, else Whitted)\n"
+          "  --estimator E  the path tracer's: bsdf (BSDF sampling only), nee (next-event\n"
+          "             estimation) or mis (both, by multiple importance sampling; default)\n"
+          "  --no-roulette  no Russian roulette: paths end at -d only\n"
+          "  --seed N   the path tracer's noise (default 0): another N, other noise\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
           "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
           "             the tree from 8 objects up)\n"
@@ -1947,7 +2721,9 @@ static int build_accel(Scene *s, const char *accel)
 static void print_stats(const Scene *s, const Counts *st, int spp, double load, double build,
                         double seconds)
 {
-    unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted;
+    static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
+                                              "MIS (BSDF sampling and next-event estimation)" };
+    unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted + st->bounced;
     fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d lights; read in %.3f s\n",
             s->nsph, s->ncone, s->ntri, s->nlight, load);
     fprintf(stderr, "image      %dx%d, %d spp, depth %d, %d thread%s\n", s->w, s->h, spp, s->depth,
@@ -1962,8 +2738,17 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
                 k.bytes / 1e6, k.sah_cost, build);
     } else
         fprintf(stderr, "kd-tree    none: every ray tests every object\n");
-    fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
-            rays, st->primary, st->shadow, st->reflected, st->refracted);
+    if (s->integrator == PATH) {
+        char bound[32] = "none but roulette";
+        if (s->max_rays) sprintf(bound, "%d rays", s->max_rays);
+        fprintf(stderr, "paths      %s, roulette %s, length bound %s, seed %u, %d lights\n",
+                estimators[s->estimator], s->roulette ? "on" : "off", bound, s->seed, s->nemit);
+        fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu bounced\n",
+                rays, st->primary, st->shadow, st->bounced);
+        fprintf(stderr, "samples    %llu discarded (not finite)\n", st->discarded);
+    } else
+        fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
+                rays, st->primary, st->shadow, st->reflected, st->refracted);
     fprintf(stderr, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
             st->nearest ? 100.0 * st->hits / (double)st->nearest : 0.0);
     fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
@@ -1978,6 +2763,46 @@ static void free_scene(Scene *s)
     if (s->kd) kd_free(s->kd);
     free(s->mat); free(s->sph); free(s->cone); free(s->tri);
     free(s->vert); free(s->norm); free(s->light);
+    free(s->emit); free(s->emit_cdf); free(s->emitter);
+}
+
+/* The command line's choices for the path tracer (-1: not given) onto the
+ * scene, and its lights; 0 with a message when they cannot work. */
+static int settle_path_options(Scene *s, int integrator, int estimator, int roulette, long seed)
+{
+    if (integrator >= 0) s->integrator = integrator;
+    if (estimator >= 0) s->estimator = estimator;
+    if (seed >= 0) s->seed = (unsigned)seed;
+    s->roulette = roulette;
+    if (s->integrator != PATH) return 1;
+    if (!roulette && !s->max_rays) {
+        fprintf(stderr, "ray: --no-roulette needs -d N: without either, paths would not end\n");
+        return 0;
+    }
+    prepare_lights(s);
+    return 1;
+}
+
+/* Whether name ends with the suffix, in any case. */
+static int ends_with(const char *name, const char *suffix)
+{
+    size_t n = strlen(name), k = strlen(suffix), i;
+    if (n < k) return 0;
+    for (i = 0; i < k; i++)
+        if (tolower((unsigned char)name[n - k + i]) != tolower((unsigned char)suffix[i])) return 0;
+    return 1;
+}
+
+/* An image of w x h pixels, floats or bytes (through the sRGB curve for a
+ * path-traced one). */
+static int new_image(Image *img, int w, int h, int floats, int srgb)
+{
+    img->w = w;
+    img->h = h;
+    img->srgb = srgb;
+    img->bytes = floats ? NULL : malloc((size_t)w * h * 3);
+    img->floats = floats ? malloc((size_t)w * h * 3 * sizeof *img->floats) : NULL;
+    return img->bytes || img->floats;
 }
 
 /* -s WxH onto the scene; 0 with a message when it is not such a size. */
@@ -1999,13 +2824,14 @@ static int set_size(Scene *s, const char *size)
 int main(int argc, char **argv)
 {
     Scene s;
-    Options o = { 1, 0, 0 };
+    Options o = { 0, 0, 0 };
     Counts st;
     Output out;
+    Image img;
     const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
     char *auto_name = NULL;
-    int i, depth = 0, plain = 0, stats = 0, ok;
-    unsigned char *img;
+    int i, depth = 0, plain = 0, stats = 0, ok, integrator = -1, estimator = -1, roulette = 1;
+    long seed = -1;
     double t0, load, build;
 
     for (i = 1; i < argc; i++) {
@@ -2021,6 +2847,13 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--accel") && next
                  && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
             accel = argv[++i];
+        else if (!strcmp(a, "--pt")) integrator = PATH;
+        else if (!strcmp(a, "--whitted")) integrator = WHITTED;
+        else if (!strcmp(a, "--no-roulette")) roulette = 0;
+        else if (!strcmp(a, "--seed")) { seed = int_arg(a, next, 2147483647) - 1; i++; }
+        else if (!strcmp(a, "--estimator") && next
+                 && (!strcmp(next, "bsdf") || !strcmp(next, "nee") || !strcmp(next, "mis")))
+            estimator = !strcmp(argv[++i], "bsdf") ? BSDF_ONLY : !strcmp(argv[i], "nee") ? NEE : MIS;
         else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "ray: unknown option, or a bad or missing value: %s\n", a);
             usage(stderr);
@@ -2036,15 +2869,16 @@ int main(int argc, char **argv)
     ok = load_scene(&s, scene) && (!size || set_size(&s, size));
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
-    if (depth) s.depth = depth;
+    if (depth) s.depth = s.max_rays = depth;
+    if (ok && !settle_path_options(&s, integrator, estimator, roulette, seed)) ok = 0;
+    if (!o.spp) o.spp = s.spp ? s.spp : 1;
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
     if (ok && !name) name = auto_name = default_output(scene);
     if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
 
-    img = malloc((size_t)s.w * s.h * 3);
-    if (!img) {
+    if (!new_image(&img, s.w, s.h, ends_with(name, ".pfm"), s.integrator == PATH)) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h);
         discard_output(&out);
         free_scene(&s); free(auto_name);
@@ -2052,12 +2886,14 @@ int main(int argc, char **argv)
     }
     o.progress = stderr_is_terminal();
     memset(&st, 0, sizeof st);
+    if (s.integrator == PATH && s.warning[0]) fprintf(stderr, "%s\n", s.warning);
     t0 = now();
-    render(&s, &o, img, &st);
+    render(&s, &o, &img, &st);
     t0 = now() - t0;
-    ok = write_ppm(&out, img, s.w, s.h, plain);
+    ok = write_image(&out, &img, plain);
     if (stats) print_stats(&s, &st, o.spp, load, build, t0);
-    free(img);
+    free(img.bytes);
+    free(img.floats);
     free(auto_name);
     free_scene(&s);
     return ok ? 0 : 1;

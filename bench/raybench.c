@@ -323,7 +323,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
         Ray r;
         r.o = v3(rays[i].o[0], rays[i].o[1], rays[i].o[2]);
         r.d = v3(rays[i].d[0], rays[i].d[1], rays[i].d[2]);
-        r.skip = -1;
+        r.skip = -1, r.tmin = 0;
         if (bare) {
             double o[3], d[3], tmax = INFINITY;
             o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
@@ -434,7 +434,7 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
         for (k = 0; k < 3; k++) o[k] = rays[i].o[k], d[k] = rays[i].d[k];
         r.o = v3(o[0], o[1], o[2]);
         r.d = v3(d[0], d[1], d[2]);
-        r.skip = -1;
+        r.skip = -1, r.tmin = 0;
         q = query(r);
         rb_probe.ray = (unsigned long)i + 1;
         kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, &c);

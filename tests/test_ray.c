@@ -39,9 +39,9 @@ static Sphere sphere(double x, double y, double z, double r)
     return s;
 }
 
-static Ray ray(vec o, vec d) { Ray r; r.o = o; r.d = d; r.skip = -1; return r; }
+static Ray ray(vec o, vec d) { Ray r; r.o = o; r.d = d; r.tmin = 0; r.skip = -1; return r; }
 /* The same, for the intersection tests, which take the ray by pointer. */
-static const Ray *rp(vec o, vec d) { static Ray r; r.o = o; r.d = d; r.skip = -1; return &r; }
+static const Ray *rp(vec o, vec d) { static Ray r; r.o = o; r.d = d; r.tmin = 0; r.skip = -1; return &r; }
 
 /* The near root in long double, as a reference: 64-bit mantissa, and the
  * stable form, so its error is far below what is tested. */
@@ -369,7 +369,7 @@ static void test_tree_matches_loop(void)
         Hit a, b;
         int ha, hb;
         Ray ry;
-        ry.skip = -1;
+        ry.skip = -1, ry.tmin = 0;
         ry.o = v3(8 * rnd(&x) - 4, 8 * rnd(&x) - 4, 8 * rnd(&x) - 4);
         ry.d = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5));
         switch (r % 5) {

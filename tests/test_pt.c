@@ -1,0 +1,554 @@
+/* test_pt.c - the path tracer against analytic answers.
+ *
+ * ray.c is included whole, as tests/test_ray.c does.  Each check of a Monte
+ * Carlo estimate compares float values (never bytes) and allows K standard
+ * errors, the standard error measured from the samples themselves.  K = 4:
+ * a correct estimator fails one check in about 16000; the seeds are fixed,
+ * so a run that passes passes again.  Where an estimate has no variance (a
+ * furnace with a depth bound and no roulette), it must be exact to 1e-9.
+ * Prints "PASS name" / "FAIL name" lines for tests/run.sh. */
+#define main ray_main
+#include "../ray.c"
+#undef main
+#include <stdarg.h>
+
+#define K 4.0
+
+static int failures;
+
+static void report(int ok, const char *name, const char *fmt, ...)
+{
+    va_list ap;
+    printf("%s %s (", ok ? "PASS" : "FAIL", name);
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    printf(")\n");
+    fflush(stdout);
+    failures += !ok;
+}
+
+/* Running mean and variance of one channel's samples. */
+typedef struct { double n, sum, sum2; } Stat;
+
+static void stat_add(Stat *st, double x) { st->n++; st->sum += x; st->sum2 += x * x; }
+static double stat_mean(const Stat *st) { return st->sum / st->n; }
+static double stat_se(const Stat *st)
+{
+    double m = stat_mean(st), var = (st->sum2 - st->n * m * m) / (st->n - 1);
+    return sqrt(fmax(var, 0) / st->n);
+}
+
+/* |mean - want| within K standard errors, or exact when there is no
+ * variance to speak of. */
+static int agrees(const Stat *st, double want)
+{
+    return fabs(stat_mean(st) - want) <= K * stat_se(st) + 1e-9 * fabs(want);
+}
+
+static Worker worker(void)
+{
+    Worker wk;
+    int i;
+    memset(&wk, 0, sizeof wk);
+    for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
+    return wk;
+}
+
+static int material(Scene *s, vec color, double kd, double ks, double kt, double kl, double ir,
+                    double shine)
+{
+    Material m;
+    m.color = color;
+    m.kd = kd; m.ks = ks; m.kt = kt; m.kl = kl; m.ir = ir; m.shine = shine;
+    return add_material(s, m);
+}
+
+static void camera(Scene *s, vec eye, vec at, vec up, double fov)
+{
+    real v[10];
+    v[0] = eye.x; v[1] = eye.y; v[2] = eye.z; v[3] = at.x; v[4] = at.y; v[5] = at.z;
+    v[6] = up.x; v[7] = up.y; v[8] = up.z; v[9] = fov;
+    set_camera(s, (Where){ "", 0 }, v);
+}
+
+/* The scene made ready for the path tracer: estimator, roulette, a bound
+ * on the rays of a path (0: none), the structure, the lights. */
+static void ready(Scene *s, int estimator, int roulette, int max_rays)
+{
+    s->max_rays = max_rays;
+    build_accel(s, "auto");
+    settle_path_options(s, PATH, estimator, roulette, 7);
+}
+
+/* n samples spread over the image, channel c of each. */
+static Stat image_samples(const Scene *s, int n, int c)
+{
+    Worker wk = worker();
+    Stat st = { 0, 0, 0 };
+    int k;
+    for (k = 0; k < n; k++) {
+        int pixel = k % (s->w * s->h);
+        vec L = sample_radiance(s, pixel % s->w, pixel / s->w, k / (s->w * s->h), &wk);
+        stat_add(&st, c == 0 ? L.x : c == 1 ? L.y : L.z);
+    }
+    return st;
+}
+
+static const char *const est_name[] = { "bsdf", "nee", "mis" };
+
+/* ---- the furnace ---- */
+
+/* Inside a closed sphere of albedo a whose wall emits Le, radiance is the
+ * same everywhere: Le + a Le + a^2 Le + ... = Le / (1 - a), and with at most
+ * N bounces (N + 1 rays) Le (1 - a^(N+1)) / (1 - a).  Each estimator, with
+ * roulette on and off. */
+static void test_furnace(void)
+{
+    static const double albedo[2] = { 0.5, 0.8 };
+    int e, ai, roulette, bounces;
+    char name[160];
+    for (ai = 0; ai < 2; ai++)
+        for (e = 0; e < 3; e++)
+            for (roulette = 1; roulette >= 0; roulette--)
+                for (bounces = -1; bounces <= 3; bounces += 2) {
+                    double a = albedo[ai], Le = 1.5, want;
+                    Scene s;
+                    Stat st;
+                    if (bounces < 0 && !roulette) continue;   /* paths would not end */
+                    default_scene(&s);
+                    s.w = s.h = 8;
+                    add_sphere(&s, v3(1, 2, 3), 2, material(&s, v3(1, 1, 1), a, 0, 0, Le, 1, 0));
+                    camera(&s, v3(1, 2, 3), v3(1, 3, 3), v3(0, 0, 1), 90);
+                    ready(&s, e, roulette, bounces < 0 ? 0 : bounces + 1);
+                    want = bounces < 0 ? Le / (1 - a) : Le * (1 - pow(a, bounces + 1)) / (1 - a);
+                    st = image_samples(&s, 20000, 0);
+                    sprintf(name, "furnace, albedo %.1f, %s, roulette %s, %s: L = %s",
+                            a, est_name[e], roulette ? "on" : "off",
+                            bounces < 0 ? "no bound" : bounces == 1 ? "1 bounce" : "3 bounces",
+                            bounces < 0 ? "Le/(1-a)" : "Le(1-a^(N+1))/(1-a)");
+                    report(agrees(&st, want), name, "%.6f +- %.6f, want %.6f", stat_mean(&st),
+                           stat_se(&st), want);
+                    free_scene(&s);
+                }
+}
+
+/* ---- a point light inside a sphere ---- */
+
+/* A point light of intensity I at the centre of a sphere of radius R and
+ * albedo rho: the wall receives I / R^2 directly and sends rho/pi of it
+ * back, and the bounces multiply that by 1 / (1 - rho):
+ * L = rho I / (pi R^2 (1 - rho)).  BSDF sampling alone never finds a point
+ * light, so it must see nothing at all. */
+static void test_point_in_sphere(void)
+{
+    double R = 2.5, rho = 0.6, I = 3;
+    int e;
+    char name[160];
+    for (e = 0; e < 3; e++) {
+        Scene s;
+        Stat st;
+        double want;
+        default_scene(&s);
+        s.w = s.h = 8;
+        add_sphere(&s, v3(0, 0, 0), R, material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0));
+        add_light(&s, v3(0, 0, 0), v3(I, I, I), -1);
+        camera(&s, v3(0.3, -0.2, 0.1), v3(1, 1, 0.5), v3(0, 0, 1), 100);
+        ready(&s, e, 1, 0);
+        st = image_samples(&s, 20000, 1);
+        want = e == BSDF_ONLY ? 0 : rho * I / (PI * R * R * (1 - rho));
+        sprintf(name, "point light in a sphere, %s: L = %s", est_name[e],
+                e == BSDF_ONLY ? "0 (BSDF sampling cannot find a point light)"
+                               : "rho I / (pi R^2 (1 - rho))");
+        report(agrees(&st, want), name, "%.6f +- %.6f, want %.6f", stat_mean(&st), stat_se(&st), want);
+        free_scene(&s);
+    }
+}
+
+/* ---- a sphere light is a point light ---- */
+
+/* A Lambertian sphere of radius r and radiance Le emits Phi = pi Le 4 pi r^2,
+ * and on a receiver that sees all of it, it lights like a point light of
+ * intensity Phi / 4 pi = pi r^2 Le at its centre: E = I cos(theta) / d^2.
+ * A floor of albedo rho under a sphere light; the radiance of random floor
+ * points straight up, direct light only (2 rays a path), against
+ * rho / pi * I cos(theta) / d^2 point by point. */
+static void test_sphere_is_point(void)
+{
+    double r = 0.5, Le = 2, rho = 0.7, I = PI * r * r * Le;
+    vec c = v3(0.7, -0.4, 2.2);
+    int e;
+    char name[160];
+    for (e = 0; e < 3; e++) {
+        Scene s;
+        Worker wk = worker();
+        Stat st = { 0, 0, 0 };
+        int floor_mat, k, a, b, c2;
+        default_scene(&s);
+        floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
+        a = add_vertex(&s, v3(-6, -6, 0));
+        b = add_vertex(&s, v3(6, -6, 0));
+        c2 = add_vertex(&s, v3(6, 6, 0));
+        add_triangle(&s, a, b, c2, -1, -1, -1, floor_mat);
+        add_triangle(&s, a, c2, add_vertex(&s, v3(-6, 6, 0)), -1, -1, -1, floor_mat);
+        add_sphere(&s, c, r, material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
+        ready(&s, e, 0, 2);
+        for (k = 0; k < 40000; k++) {
+            Path path;
+            Ray ry;
+            vec p, d, L;
+            double want;
+            start_sample(&wk, &s, k, 1, 0);
+            p = v3(4 * random01(&wk) - 2, 4 * random01(&wk) - 2, 0);
+            ry.o = v3(p.x, p.y, 1);             /* below the light, above the floor */
+            ry.d = v3(0, 0, -1);
+            ry.tmin = 0, ry.skip = -1;
+            path.beta = v3(1, 1, 1), path.rays = 1, path.counted = 1, path.pdf = 0;
+            L = radiance(&s, ry, &path, &wk);
+            d = sub(c, p);
+            want = rho / PI * I * d.z / sqrt(dot(d, d)) / dot(d, d);
+            stat_add(&st, L.x - want);
+        }
+        sprintf(name, "sphere light = point light of intensity Phi/4pi on a floor, %s", est_name[e]);
+        report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points", stat_mean(&st),
+               stat_se(&st), st.n);
+        free_scene(&s);
+    }
+}
+
+/* ---- lossless objects vanish in a white room ---- */
+
+/* In a uniform environment of radiance 1, a perfect mirror and a glass ball
+ * without absorption return 1 along every ray: what the glass lets in, it
+ * lets out (the eta^2 of radiance entering and leaving cancel), and what
+ * Fresnel reflects, the mirror keeps.  A camera sees a sphere filling most
+ * of the view. */
+static void test_lossless(void)
+{
+    int e, glass;
+    char name[160];
+    for (glass = 0; glass < 2; glass++)
+        for (e = 0; e < 3; e++) {
+            Scene s;
+            Stat st;
+            default_scene(&s);
+            s.w = s.h = 16;
+            s.background = v3(1, 1, 1);
+            add_sphere(&s, v3(0, 0, 0), 1,
+                       material(&s, v3(1, 1, 1), 0, glass ? 0 : 1, glass ? 1 : 0, 0, 1.5, 0));
+            camera(&s, v3(0, -4, 0.3), v3(0, 0, 0), v3(0, 0, 1), 30);
+            ready(&s, e, 1, 0);
+            st = image_samples(&s, 40000, 2);
+            sprintf(name, "a %s ball in a white room vanishes, %s", glass ? "glass" : "mirror",
+                    est_name[e]);
+            report(agrees(&st, 1), name, "%.6f +- %.6f, want 1", stat_mean(&st), stat_se(&st));
+            free_scene(&s);
+        }
+}
+
+/* ---- the BSDFs ---- */
+
+/* A BSDF on the plane z = 0 seen from wo. */
+static Bsdf plane_bsdf(vec albedo, double glossy, double shine, vec wo)
+{
+    Scene s;
+    Hit h;
+    Bsdf b;
+    default_scene(&s);
+    material(&s, albedo, 1, glossy, 0, 0, 1, shine);
+    h.n = h.ng = v3(0, 0, 1);
+    h.mat = 0;
+    b = bsdf_at(&s, &h, wo);
+    free_scene(&s);
+    return b;
+}
+
+static vec polar(double theta, double phi)
+{
+    return v3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
+}
+
+typedef struct { const char *name; vec albedo; double glossy, shine; } Lobe;
+
+static const Lobe lobes[] = {
+    { "Lambert", { 0.8, 0.5, 0.25 }, 0, 0 },
+    { "Phong 1", { 0, 0, 0 }, 0.9, 1 },
+    { "Phong 10", { 0, 0, 0 }, 0.9, 10 },
+    { "Phong 200", { 0, 0, 0 }, 1, 200 },
+    { "Lambert + Phong 30", { 0.4, 0.4, 0.4 }, 0.5, 30 },
+};
+#define NLOBES ((int)(sizeof lobes / sizeof lobes[0]))
+
+/* Helmholtz reciprocity, f(a, b) = f(b, a), on random pairs above the
+ * surface, to rounding. */
+static void test_reciprocity(void)
+{
+    int l, k;
+    char name[96];
+    for (l = 0; l < NLOBES; l++) {
+        Worker wk = worker();
+        double worst = 0;
+        start_sample(&wk, &(Scene){ 0 }, l, 0, 0);
+        for (k = 0; k < 100000; k++) {
+            vec a = polar(acos(random01(&wk)), 2 * PI * random01(&wk));
+            vec b = polar(acos(random01(&wk)), 2 * PI * random01(&wk));
+            Bsdf ba = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, a);
+            Bsdf bb = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, b);
+            vec f1 = bsdf_eval(&ba, a, b), f2 = bsdf_eval(&bb, b, a);
+            double d = fabs(f1.x - f2.x) / fmax(1e-300, fabs(f1.x));
+            if (f1.x != f2.x && !(d <= worst)) worst = d;
+        }
+        sprintf(name, "%s: reciprocity f(a,b) = f(b,a) on 1e5 pairs", lobes[l].name);
+        report(worst <= 1e-12, name, "worst relative difference %.2g", worst);
+    }
+}
+
+/* Energy: the albedo, the integral of f cos over the hemisphere, estimated
+ * from the BSDF's own samples (the mean of f cos / pdf), is at most 1 for
+ * light from any direction; and it equals an estimate by uniform sampling
+ * of the hemisphere, which does not trust the BSDF's sampling. */
+static void test_energy(void)
+{
+    static const double angles[4] = { 0, 30, 60, 85 };
+    int l, a, k;
+    char name[128];
+    for (l = 0; l < NLOBES; l++)
+        for (a = 0; a < 4; a++) {
+            vec wo = polar(angles[a] * PI / 180, 0.3);
+            Bsdf b = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, wo);
+            Worker wk = worker();
+            Stat own = { 0, 0, 0 }, uni = { 0, 0, 0 };
+            start_sample(&wk, &(Scene){ 0 }, l, a, 1);
+            for (k = 0; k < 200000; k++) {
+                vec wi, f_cos, wu, f;
+                real pdf;
+                double m;
+                int lobe = sample_bsdf(&b, wo, &wk, &wi, &f_cos, &pdf);
+                stat_add(&own, lobe < 0 ? 0 : fmax(f_cos.x, fmax(f_cos.y, f_cos.z)));
+                wu = polar(acos(random01(&wk)), 2 * PI * random01(&wk));
+                f = bsdf_eval(&b, wo, wu);
+                m = fmax(f.x, fmax(f.y, f.z));
+                stat_add(&uni, m * wu.z * 2 * PI);
+            }
+            sprintf(name, "%s from %g degrees: albedo <= 1, and its own sampling = uniform sampling",
+                    lobes[l].name, angles[a]);
+            report(stat_mean(&own) <= 1 + K * stat_se(&own)
+                       && fabs(stat_mean(&own) - stat_mean(&uni))
+                              <= K * sqrt(stat_se(&own) * stat_se(&own) + stat_se(&uni) * stat_se(&uni)),
+                   name, "albedo %.4f +- %.4f, uniform %.4f", stat_mean(&own), stat_se(&own),
+                   stat_mean(&uni));
+        }
+}
+
+/* Q(a, x), the regularised upper incomplete gamma function: the chance that
+ * a chi-square variable of 2a degrees of freedom exceeds 2x.  Its series
+ * below a + 1, its continued fraction above (evaluated by Lentz's method). */
+static double gamma_q(double a, double x)
+{
+    double lg = lgamma(a), sum, term, b, c, d, h;
+    int n;
+    if (x <= 0) return 1;
+    if (x < a + 1) {
+        sum = term = 1 / a;
+        for (n = 1; n < 100000 && fabs(term) > fabs(sum) * 1e-15; n++) {
+            term *= x / (a + n);
+            sum += term;
+        }
+        return 1 - sum * exp(-x + a * log(x) - lg);
+    }
+    b = x + 1 - a;
+    c = 1e300;
+    d = 1 / b;
+    h = d;
+    for (n = 1; n < 100000; n++) {
+        double an = -n * (n - a), del;
+        b += 2;
+        d = an * d + b;
+        if (fabs(d) < 1e-300) d = 1e-300;
+        c = b + an / c;
+        if (fabs(c) < 1e-300) c = 1e-300;
+        d = 1 / d;
+        del = d * c;
+        h *= del;
+        if (fabs(del - 1) < 1e-15) break;
+    }
+    return exp(-x + a * log(x) - lg) * h;
+}
+
+/* The integral of the BSDF's pdf over a cell of theta x phi, by the
+ * midpoint rule on an 8 x 8 grid of the cell (the solid angle is
+ * sin(theta) dtheta dphi).  Midpoints, not the cell's edges: the pdf drops
+ * to 0 at the horizon, and a rule that samples the edge itself would give
+ * the cell below the horizon a share of the one above. */
+static double cell_integral(const Bsdf *b, vec wo, double t0, double t1, double p0, double p1)
+{
+    double sum = 0;
+    int i, j;
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) {
+            double t = t0 + (t1 - t0) * (i + 0.5) / 8, p = p0 + (p1 - p0) * (j + 0.5) / 8;
+            sum += bsdf_pdf(b, wo, polar(t, p)) * sin(t);
+        }
+    return sum * (t1 - t0) / 8 * (p1 - p0) / 8;
+}
+
+#define NT 80
+#define NP 160
+#define CHI_SAMPLES 1000000
+
+/* Pearson's chi-square test that sample_bsdf draws directions with the
+ * density bsdf_pdf says: 10^6 samples in 80 x 160 cells of theta x phi, the
+ * counts expected from the pdf integrated over each cell, cells expecting
+ * fewer than 5 pooled, and one more cell for the samples that end the path
+ * (a Phong direction below the surface).  The significance 0.01 is shared
+ * among the tests by Sidak's correction.  (As Mitsuba's and pbrt's tests do;
+ * the method: Pearson 1900.) */
+static void test_chi2(void)
+{
+    static const double angles[2] = { 30, 75 };
+    int ntests = NLOBES * 2, l, a;
+    double alpha = 1 - pow(1 - 0.01, 1.0 / ntests);
+    char name[128];
+    static double observed[NT * NP + 1], expected[NT * NP + 1];
+    for (l = 0; l < NLOBES; l++)
+        for (a = 0; a < 2; a++) {
+            vec wo = polar(angles[a] * PI / 180, 1.1);
+            Bsdf b = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, wo);
+            Worker wk = worker();
+            double chi2 = 0, pool_o = 0, pool_e = 0, inside = 0, p;
+            int i, j, k, dof = 0;
+            memset(observed, 0, sizeof observed);
+            start_sample(&wk, &(Scene){ 0 }, l, a, 2);
+            for (k = 0; k < CHI_SAMPLES; k++) {
+                vec wi, f_cos;
+                real pdf;
+                if (sample_bsdf(&b, wo, &wk, &wi, &f_cos, &pdf) < 0) { observed[NT * NP]++; continue; }
+                i = (int)(acos(fmax(-1, fmin(1, wi.z))) / PI * NT);
+                j = (int)((atan2(wi.y, wi.x) + PI) / (2 * PI) * NP);
+                observed[(i < NT ? i : NT - 1) * NP + (j < NP ? j : NP - 1)]++;
+            }
+            for (i = 0; i < NT; i++)
+                for (j = 0; j < NP; j++) {
+                    double e = CHI_SAMPLES * cell_integral(&b, wo, PI * i / NT, PI * (i + 1) / NT,
+                                                           2 * PI * j / NP - PI, 2 * PI * (j + 1) / NP - PI);
+                    expected[i * NP + j] = e;
+                    inside += e;
+                }
+            expected[NT * NP] = CHI_SAMPLES - inside;
+            for (k = 0; k <= NT * NP; k++) {
+                if (expected[k] < 5) { pool_o += observed[k]; pool_e += expected[k]; continue; }
+                chi2 += (observed[k] - expected[k]) * (observed[k] - expected[k]) / expected[k];
+                dof++;
+            }
+            if (pool_e > 0) {
+                chi2 += (pool_o - pool_e) * (pool_o - pool_e) / fmax(pool_e, 5);
+                dof++;
+            }
+            p = gamma_q((dof - 1) / 2.0, chi2 / 2);
+            if (getenv("CHI_DEBUG")) {
+                fprintf(stderr, "missing: obs %g exp %g; pooled obs %g exp %g\n", observed[NT*NP], expected[NT*NP], pool_o, pool_e);
+                for (k = 0; k < NT * NP; k++) if (expected[k] >= 5 && (observed[k]-expected[k])*(observed[k]-expected[k])/expected[k] > 30)
+                    fprintf(stderr, "cell t%d p%d obs %g exp %g\n", k / NP, k % NP, observed[k], expected[k]);
+            }
+            sprintf(name, "%s from %g degrees: chi-square, sampling matches the pdf", lobes[l].name,
+                    angles[a]);
+            report(p > alpha, name, "chi2 %.0f, %d cells, p = %.3g", chi2, dof, p);
+        }
+}
+
+/* Fresnel's equations at known points: ((n-1)/(n+1))^2 head on, 0 for p
+ * light at Brewster's angle (so the mean of s and p is rs^2 / 2 there), 1
+ * past the critical angle, and the same from either side of the surface
+ * for the same pair of angles. */
+static void test_fresnel(void)
+{
+    double n = 1.5, head = fresnel(1, 1 / n), tb = atan(n), ci = cos(tb), ct = cos(PI / 2 - tb);
+    double rs = (ci - n * ct) / (ci + n * ct), brewster = fresnel(ci, 1 / n);
+    double inside = fresnel(ct, n), tir = fresnel(cos(asin(1 / n) + 0.01), n);
+    report(fabs(head - 0.04) < 1e-15 && fabs(brewster - rs * rs / 2) < 1e-15
+               && fabs(inside - brewster) < 1e-15 && tir == 1,
+           "Fresnel: 0.04 head on, rs^2/2 at Brewster's angle, the same from inside, 1 past critical",
+           "%.17g %.17g %.17g", head, brewster, tir);
+}
+
+/* ---- the three estimators agree ---- */
+
+/* On the Cornell box, each estimator's mean radiance in each of 16 blocks
+ * of the image: every pair must agree within K standard errors of their
+ * difference. */
+static void test_estimators_agree(void)
+{
+    Scene s[3];
+    Stat st[3][16];
+    int e, k, worst_block = -1;
+    double worst = 0;
+    for (e = 0; e < 3; e++) {
+        Worker wk = worker();
+        if (!load_scene(&s[e], "scenes/cornell.sph")) {
+            report(0, "the three estimators agree on the Cornell box", "cannot load scenes/cornell.sph");
+            return;
+        }
+        s[e].w = s[e].h = 16;
+        ready(&s[e], e, 1, 0);
+        memset(st[e], 0, sizeof st[e]);
+        for (k = 0; k < 16 * 16 * 384; k++) {
+            int pixel = k % 256, i = pixel % 16, j = pixel / 16;
+            vec L = sample_radiance(&s[e], i, j, k / 256, &wk);
+            stat_add(&st[e][(j / 4) * 4 + i / 4], luminance(L));
+        }
+    }
+    for (k = 0; k < 16; k++)
+        for (e = 0; e < 3; e++) {
+            const Stat *a = &st[e][k], *b = &st[(e + 1) % 3][k];
+            double se = sqrt(stat_se(a) * stat_se(a) + stat_se(b) * stat_se(b));
+            double z = fabs(stat_mean(a) - stat_mean(b)) / se;
+            if (!(z <= worst)) worst = z, worst_block = k;
+        }
+    report(worst <= K, "the three estimators agree on the Cornell box, 16 blocks, 98304 paths each",
+           "worst difference %.2f standard errors, in block %d", worst, worst_block);
+    for (e = 0; e < 3; e++) free_scene(&s[e]);
+}
+
+/* Another seed gives other noise with the same mean: pixel by pixel the
+ * differences of two renders average to 0. */
+static void test_seed(void)
+{
+    Scene s;
+    Stat d = { 0, 0, 0 };
+    int i, j, same = 0;
+    if (!load_scene(&s, "scenes/cornell.sph")) {
+        report(0, "another seed", "cannot load scenes/cornell.sph");
+        return;
+    }
+    s.w = s.h = 24;
+    ready(&s, MIS, 1, 0);
+    for (j = 0; j < s.h; j++)
+        for (i = 0; i < s.w; i++) {
+            Worker wk = worker();
+            vec a, b;
+            s.seed = 1;
+            a = pixel_radiance(&s, i, j, 16, &wk);
+            s.seed = 2;
+            b = pixel_radiance(&s, i, j, 16, &wk);
+            same += a.x == b.x;
+            stat_add(&d, luminance(sub(a, b)));
+        }
+    report(same < 10 && agrees(&d, 0), "another --seed: other noise, the same mean",
+           "%d of 576 pixels equal; mean difference %.3g +- %.3g", same, stat_mean(&d), stat_se(&d));
+    free_scene(&s);
+}
+
+int main(void)
+{
+    test_fresnel();
+    test_reciprocity();
+    test_energy();
+    test_chi2();
+    test_furnace();
+    test_point_in_sphere();
+    test_sphere_is_point();
+    test_lossless();
+    test_estimators_agree();
+    test_seed();
+    return failures != 0;
+}
