@@ -18,6 +18,9 @@
 #           compared ray by ray (bench/raybench.c, ../shared/embree)
 #   pov     SPD balls at 512x512, one thread: ./ray against --accel none and
 #           against POV-Ray 3.7; and POV-Ray's other SPD scenes
+#   pt      the path tracer: each estimator's CPU time against its RMSE on the
+#           Cornell box and smallpt's scene, against smallpt, and its rays
+#           per second against Whitted's (bench/pt.sh; plotted to pt.svg)
 # Embree and POV-Ray are instruments, not dependencies: when one is missing
 # its rows say "not installed, skipped".  BENCH_INSTALL=1 first tries
 # `apt-get install -y libembree-dev povray` for the missing ones.
@@ -29,7 +32,7 @@
 #   *.log       the raw output each table was read from
 #
 # Knobs (environment; defaults keep `make bench` near 4 minutes on 2 cores):
-#   BENCH_PARTS="render spd build rays pov"
+#   BENCH_PARTS="render spd build rays pov pt"
 #   BENCH_SPP="1 4 16"       sample counts to time
 #   BENCH_REF_SPP=64         reference sample count (should exceed the above)
 #   BENCH_FLAKE_LEVEL=4      sphereflake recursion (4: 7381 spheres)
@@ -71,7 +74,7 @@ FLAKE_SIZE=${BENCH_FLAKE_SIZE:-}
 FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
-PARTS=${BENCH_PARTS:-render spd build rays pov}
+PARTS=${BENCH_PARTS:-render spd build rays pov pt}
 SPD_DIR=${BENCH_SPD_DIR:-../shared/spd}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
 NONE_BUDGET=${BENCH_NONE_BUDGET:-2}
@@ -95,7 +98,7 @@ for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N; do
   case $n in ''|*[!0-9]*|0) die "BENCH_NONE_BUDGET, BENCH_BUILD_MAX, BENCH_RAYS_RES and BENCH_RAYS_N must be whole numbers from 1, not '$n'";; esac
 done
 for p in $PARTS; do
-  case $p in render|spd|build|rays|pov) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays pov)";; esac
+  case $p in render|spd|build|rays|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays pov pt)";; esac
 done
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT" || die "cannot create $OUT"
@@ -727,6 +730,19 @@ if part pov; then
   done
   echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
   echo | tee -a "$OUT/bench.txt"
+fi
+
+# ------------------------------------------------------------ path tracing
+if part pt; then
+  t_part=$SECONDS
+  if CC="$CC" CFLAGS="$CFLAGS" bash bench/pt.sh; then
+    cat "$OUT/pt.txt" >>"$OUT/bench.txt"
+    while IFS= read -r line; do targets+=("$line"); done <"$OUT/pt-targets.txt"
+  else
+    echo "the path-tracing section failed" | tee -a "$OUT/bench.txt"
+    status=1
+  fi
+  echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
 fi
 
 # ---------------------------------------------------------------- targets

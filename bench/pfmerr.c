@@ -1,0 +1,87 @@
+/* pfmerr - the error of a path-traced image against a reference, for make
+ * bench: both are PFM files (linear radiance, as ./ray -o x.pfm writes).
+ *
+ *     cc -std=c99 -O2 -o pfmerr bench/pfmerr.c -lm
+ *     ./pfmerr IMAGE.pfm REFERENCE.pfm
+ *
+ * Prints one line, "rmse=R lit_rmse=L display_rmse=D pixels=N":
+ *   rmse          root mean square difference of the linear values, every
+ *                 pixel and channel: the bench's measure
+ *   lit_rmse      the same over the pixels whose reference is below 1 in
+ *                 every channel: in the Cornell box, all but the lamp and
+ *                 the pixels its edge crosses, where the noise of covering
+ *                 the pixel (the same for every estimator) dominates
+ *   display_rmse  of the images as shown: clamped to 0..1 and through the
+ *                 sRGB curve, in 8-bit levels
+ * Exit status 0, or 2 on an error (unreadable file, sizes differ).
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct { int w, h; float *px; } pfm;
+
+/* A colour PFM ("PF", width, height, scale; little-endian when the scale is
+ * negative), rows from the bottom.  0 with a message on any error. */
+static int load(const char *name, pfm *img)
+{
+    FILE *f = fopen(name, "rb");
+    char magic[3] = "";
+    double scale;
+    size_t n, i;
+    unsigned char b[4];
+    if (!f) { fprintf(stderr, "pfmerr: cannot open %s\n", name); return 0; }
+    if (fscanf(f, "%2s %d %d %lf", magic, &img->w, &img->h, &scale) != 4 || strcmp(magic, "PF")
+        || img->w < 1 || img->h < 1 || img->w > 32768 || img->h > 32768 || scale == 0
+        || fgetc(f) == EOF) {
+        fprintf(stderr, "pfmerr: %s is not a colour PFM\n", name);
+        fclose(f);
+        return 0;
+    }
+    n = (size_t)img->w * img->h * 3;
+    img->px = malloc(n * sizeof *img->px);
+    for (i = 0; img->px && i < n && fread(b, 1, 4, f) == 4; i++) {
+        uint32_t u = scale < 0 ? (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24
+                               : (uint32_t)b[3] | (uint32_t)b[2] << 8 | (uint32_t)b[1] << 16 | (uint32_t)b[0] << 24;
+        memcpy(&img->px[i], &u, 4);
+    }
+    fclose(f);
+    if (!img->px || i < n) {
+        fprintf(stderr, "pfmerr: %s is short\n", name);
+        return 0;
+    }
+    return 1;
+}
+
+static double shown(double v)
+{
+    v = v < 0 ? 0 : v > 1 ? 1 : v;
+    return 255 * (v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055);
+}
+
+int main(int argc, char **argv)
+{
+    pfm a, r;
+    double sum = 0, lit = 0, disp = 0;
+    long nlit = 0, k, n;
+    if (argc != 3) { fprintf(stderr, "usage: pfmerr IMAGE.pfm REFERENCE.pfm\n"); return 2; }
+    if (!load(argv[1], &a) || !load(argv[2], &r)) return 2;
+    if (a.w != r.w || a.h != r.h) { fprintf(stderr, "pfmerr: the sizes differ\n"); return 2; }
+    n = (long)a.w * a.h;
+    for (k = 0; k < n; k++) {
+        const float *p = a.px + 3 * k, *q = r.px + 3 * k;
+        int c, bright = q[0] >= 1 || q[1] >= 1 || q[2] >= 1;
+        for (c = 0; c < 3; c++) {
+            double d = (double)p[c] - q[c], e = shown(p[c]) - shown(q[c]);
+            sum += d * d;
+            disp += e * e;
+            if (!bright) lit += d * d;
+        }
+        nlit += !bright;
+    }
+    printf("rmse=%.6g lit_rmse=%.6g display_rmse=%.4g pixels=%ld\n", sqrt(sum / (3.0 * n)),
+           nlit ? sqrt(lit / (3.0 * nlit)) : 0.0, sqrt(disp / (3.0 * n)), n);
+    return 0;
+}
