@@ -86,6 +86,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define RAY_POSIX
 #endif
+#include <ctype.h>
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -164,6 +165,7 @@ typedef struct {
     Light *light;   int nlight, caplight;
     Camera cam;
     int w, h, depth;
+    int gamma;                /* 1: the sRGB curve on the output (--gamma, srgb_encode) */
     vec ambient, background;
     int cull;                 /* for triangles still to come: `sided 1` */
     int accel;                /* which structure finds hits: ACCEL_NONE or ACCEL_KD */
@@ -271,6 +273,7 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
 static void sample_offset(int k, real anchor, real *dx, real *dy);
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
 static unsigned char to_byte(real v);
+static real srgb_encode(real linear);         /* --gamma, in the plumbing */
 
 /* RayTrace(R): Whitted's recursive ray tracing */
 static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
@@ -321,6 +324,7 @@ static void render_row(const Scene *s, int j, int spp, unsigned char *row, Worke
     int i;
     for (i = 0; i < s->w; i++) {
         vec c = pixel_color(s, i, j, spp, wk);
+        if (s->gamma) c = v3(srgb_encode(c.x), srgb_encode(c.y), srgb_encode(c.z));
         row[3 * i] = to_byte(c.x);
         row[3 * i + 1] = to_byte(c.y);
         row[3 * i + 2] = to_byte(c.z);
@@ -1809,13 +1813,188 @@ static int load_scene(Scene *s, const char *file)
 
 /* ------------------------------------------------------------------ output */
 
+/* --gamma: linear light to the sRGB transfer curve (IEC 61966-2-1), which
+ * image viewers assume a PPM or PNG holds: a straight line near black, then
+ * a 1/2.4 power.  Without --gamma the bytes stay linear, as the card's are.
+ * Values outside 0..1 are left to to_byte to clamp; NaN stays NaN (black). */
+static real srgb_encode(real linear)
+{
+    if (!(linear > 0.0031308)) return (real)(12.92 * linear);
+    return (real)(1.055 * pow(linear, 1 / 2.4) - 0.055);
+}
+
+/* Does name end with ext (given in lower case), in any case? */
+static int has_extension(const char *name, const char *ext)
+{
+    size_t n = strlen(name), k = strlen(ext), i;
+    if (n < k) return 0;
+    for (i = 0; i < k; i++)
+        if (tolower((unsigned char)name[n - k + i]) != ext[i]) return 0;
+    return 1;
+}
+
+enum { FORMAT_PPM, FORMAT_PNG, FORMAT_OTHER };
+
+/* The format -o asks for, by its extension: .png is PNG; anything else is
+ * PPM (.ppm, stdout, a device, a name without an extension), except the
+ * image formats this program cannot write, which are refused rather than
+ * given a PPM under their name. */
+static int output_format(const char *name)
+{
+    static const char *const other[] = { ".jpg", ".jpeg", ".gif", ".bmp", ".tif", ".tiff",
+                                         ".webp", ".tga", ".exr", ".hdr" };
+    size_t i;
+    if (has_extension(name, ".png")) return FORMAT_PNG;
+    for (i = 0; i < sizeof other / sizeof *other; i++)
+        if (has_extension(name, other[i])) return FORMAT_OTHER;
+    return FORMAT_PPM;
+}
+
+/* PNG (ISO/IEC 15948) without a compressor: the rows, each after filter
+ * byte 0 ("none"), make a zlib stream (RFC 1950) of stored deflate blocks
+ * (RFC 1951: a block's bytes as they are, after their count and its
+ * complement), one IDAT chunk per block.  Each chunk ends with the CRC-32
+ * of its type and data; the zlib stream ends with the Adler-32 of the rows. */
+#define STORED_MAX 65535                  /* the most bytes a stored block holds */
+
+typedef struct {
+    FILE *f;
+    unsigned long crc[256];               /* CRC-32 of each byte value */
+    unsigned long a, b;                   /* Adler-32's two sums */
+    unsigned char buf[2 + 5 + STORED_MAX + 4]; /* one IDAT chunk's data */
+    size_t n, start;                      /* bytes in buf; where the block's bytes start */
+} Png;
+
+/* The table of CRC-32 (the polynomial of ISO 3309, bits reversed). */
+static void crc_table(unsigned long t[256])
+{
+    unsigned long c;
+    int n, k;
+    for (n = 0; n < 256; n++) {
+        for (c = (unsigned long)n, k = 0; k < 8; k++) c = c & 1 ? 0xEDB88320UL ^ c >> 1 : c >> 1;
+        t[n] = c;
+    }
+}
+
+static unsigned long crc_update(const unsigned long t[256], unsigned long crc,
+                                const unsigned char *p, size_t n)
+{
+    while (n--) crc = t[(crc ^ *p++) & 0xFF] ^ crc >> 8;
+    return crc;
+}
+
+/* Four bytes, most significant first, as PNG and zlib store numbers. */
+static void put32(unsigned char *p, unsigned long v)
+{
+    p[0] = (unsigned char)(v >> 24 & 0xFF);
+    p[1] = (unsigned char)(v >> 16 & 0xFF);
+    p[2] = (unsigned char)(v >> 8 & 0xFF);
+    p[3] = (unsigned char)(v & 0xFF);
+}
+
+/* One chunk: its length, type, data and CRC. */
+static void png_chunk(Png *png, const char *type, const unsigned char *data, size_t n)
+{
+    unsigned char head[8], tail[4];
+    put32(head, (unsigned long)n);
+    memcpy(head + 4, type, 4);
+    put32(tail, crc_update(png->crc, crc_update(png->crc, 0xFFFFFFFFUL, head + 4, 4), data, n)
+                    ^ 0xFFFFFFFFUL);
+    fwrite(head, 1, 8, png->f);
+    fwrite(data, 1, n, png->f);
+    fwrite(tail, 1, 4, png->f);
+}
+
+/* The block in buf as an IDAT chunk; the last one also closes the zlib
+ * stream with its Adler-32.  The next block's header goes at buf[0]. */
+static void png_block(Png *png, int last)
+{
+    size_t len = png->n - png->start;
+    unsigned char *head = png->buf + png->start - 5;
+    head[0] = (unsigned char)last;        /* BFINAL, and BTYPE 00: stored */
+    head[1] = (unsigned char)(len & 0xFF);
+    head[2] = (unsigned char)(len >> 8);
+    head[3] = (unsigned char)(~len & 0xFF);
+    head[4] = (unsigned char)(~len >> 8 & 0xFF);
+    if (last) {
+        put32(png->buf + png->n, png->b << 16 | png->a);
+        png->n += 4;
+    }
+    png_chunk(png, "IDAT", png->buf, png->n);
+    png->n = png->start = 5;
+}
+
+/* Bytes of the rows into the zlib stream, a stored block at a time. */
+static void png_put(Png *png, const unsigned char *p, size_t n)
+{
+    while (n > 0) {
+        size_t room = STORED_MAX - (png->n - png->start), k = n < room ? n : room, i;
+        if (room == 0) { png_block(png, 0); continue; }
+        for (i = 0; i < k; i++) {
+            png->a = (png->a + p[i]) % 65521;
+            png->b = (png->b + png->a) % 65521;
+        }
+        memcpy(png->buf + png->n, p, k);
+        png->n += k;
+        p += k;
+        n -= k;
+    }
+}
+
+/* An 8-bit RGB PNG; with srgb, it says its bytes are sRGB (the sRGB chunk,
+ * and gAMA 1/2.2 for readers that know only that). 0: out of memory. */
+static int write_png(FILE *f, const unsigned char *img, int w, int h, int srgb)
+{
+    static const unsigned char signature[8] = { 137, 'P', 'N', 'G', 13, 10, 26, 10 };
+    unsigned char ihdr[13] = { 0 }, zero = 0, gamma[4];
+    Png *png = malloc(sizeof *png);
+    int j;
+    if (!png) return 0;
+    png->f = f;
+    crc_table(png->crc);
+    png->a = 1;
+    png->b = 0;
+    png->buf[0] = 0x78;                   /* zlib: deflate, 32K window; */
+    png->buf[1] = 0x01;                   /* 0x7801 is a multiple of 31 */
+    png->n = png->start = 2 + 5;
+    fwrite(signature, 1, 8, f);
+    put32(ihdr, (unsigned long)w);
+    put32(ihdr + 4, (unsigned long)h);
+    ihdr[8] = 8;                          /* bits per channel */
+    ihdr[9] = 2;                          /* RGB; compression, filter, interlace 0 */
+    png_chunk(png, "IHDR", ihdr, 13);
+    if (srgb) {
+        put32(gamma, 45455);
+        png_chunk(png, "sRGB", &zero, 1); /* rendering intent 0, perceptual */
+        png_chunk(png, "gAMA", gamma, 4);
+    }
+    for (j = 0; j < h; j++) {
+        png_put(png, &zero, 1);           /* filter type 0, none */
+        png_put(png, img + (size_t)3 * w * j, (size_t)3 * w);
+    }
+    png_block(png, 1);
+    png_chunk(png, "IEND", png->buf, 0);
+    free(png);
+    return 1;
+}
+
+static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain)
+{
+    size_t i, n = (size_t)w * h * 3;
+    fprintf(f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
+    if (plain)
+        for (i = 0; i < n; i += 3) fprintf(f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
+    else
+        fwrite(img, 1, n, f);
+}
+
 /* Where the image goes.  It is opened before the render, so that a bad -o
  * fails at once rather than after a long render.  A new or plain file is
  * written as FILE.tmp and renamed over FILE at the end, so that a failure
  * never leaves a half-written image behind.  Anything else (stdout, a device
  * such as /dev/null, a pipe, a symbolic link) is written in place and never
  * renamed over or removed. */
-typedef struct { FILE *f; const char *name; char *tmp; } Output;
+typedef struct { FILE *f; const char *name; char *tmp; int format; } Output;
 
 #ifdef RAY_POSIX
 /* Absent, or a plain file (not a link, a device or a pipe)? */
@@ -1833,6 +2012,7 @@ static int open_output(Output *o, const char *name)
     o->name = name;
     o->tmp = NULL;
     o->f = stdout;
+    o->format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
     if (!strcmp(name, "-")) return 1;
     if (replaceable(name)) {
         o->tmp = malloc(strlen(name) + 5);
@@ -1856,16 +2036,19 @@ static void discard_output(Output *o)
     free(o->tmp);
 }
 
-static int write_ppm(Output *o, const unsigned char *img, int w, int h, int plain)
+/* The image in the output's format, then the file closed and, if it was
+ * written as a temporary, renamed into place; on failure a message and no
+ * file.  srgb: the bytes are sRGB (--gamma), for PNG to say so. */
+static int write_image(Output *o, const unsigned char *img, int w, int h, int plain, int srgb)
 {
-    size_t i, n = (size_t)w * h * 3;
-    int ok;
-    fprintf(o->f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
-    if (plain)
-        for (i = 0; i < n; i += 3) fprintf(o->f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
-    else
-        fwrite(img, 1, n, o->f);
-    ok = fflush(o->f) == 0 && !ferror(o->f);
+    int ok = 1;
+    errno = 0;
+    if (o->format == FORMAT_PNG) {
+        ok = write_png(o->f, img, w, h, srgb);
+        if (!ok) errno = ENOMEM;
+    } else
+        write_ppm(o->f, img, w, h, plain);
+    ok = ok && fflush(o->f) == 0 && !ferror(o->f);
     if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
     if (ok && o->tmp) ok = rename(o->tmp, o->name) == 0;
     if (!ok) {
@@ -1883,12 +2066,14 @@ static void usage(FILE *to)
     fputs("usage: ray [options] SCENE\n"
           "Renders SCENE with Whitted ray tracing: the sphere format (README.md), or\n"
           "NFF (Eric Haines' Neutral File Format, the SPD scenes') when it ends .nff.\n"
-          "  -o FILE    output PPM (default: SCENE's base name + .ppm; - for stdout)\n"
+          "  -o FILE    output image: PNG if FILE ends .png, else PPM (default: SCENE's\n"
+          "             base name + .ppm; - for stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
           "  -n N       anti-aliasing samples per pixel (default 1)\n"
           "  -d N       recursion depth, 1 = primary rays only (default: scene's, else 5)\n"
           "  -t N       threads (default: all cores, when built with OpenMP)\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
+          "  --gamma    encode the output with the sRGB curve (default: linear, as the card)\n"
           "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
           "             the tree from 8 objects up)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
@@ -1906,6 +2091,18 @@ static int int_arg(const char *opt, const char *arg, int max)
         exit(2);
     }
     return (int)v;
+}
+
+/* Can -o FILE be written as asked?  Else a message (a usage error). */
+static int output_usable(const char *name, int plain)
+{
+    int format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
+    if (format == FORMAT_OTHER)
+        fprintf(stderr, "ray: cannot write %s: the formats are PPM and PNG (-o x.ppm, -o x.png)\n",
+                name);
+    else if (format == FORMAT_PNG && plain)
+        fprintf(stderr, "ray: --p3 is a PPM form; %s is a PNG\n", name);
+    return format == FORMAT_PPM || (format == FORMAT_PNG && !plain);
 }
 
 static char *default_output(const char *scene)
@@ -2004,7 +2201,7 @@ int main(int argc, char **argv)
     Output out;
     const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
     char *auto_name = NULL;
-    int i, depth = 0, plain = 0, stats = 0, ok;
+    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok;
     unsigned char *img;
     double t0, load, build;
 
@@ -2017,6 +2214,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "-d")) { depth = int_arg(a, next, 64); i++; }
         else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
         else if (!strcmp(a, "--p3")) plain = 1;
+        else if (!strcmp(a, "--gamma")) gamma = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
         else if (!strcmp(a, "--accel") && next
                  && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
@@ -2032,11 +2230,13 @@ int main(int argc, char **argv)
         else scene = a;
     }
     if (!scene) { usage(stderr); return 2; }
+    if (name && !output_usable(name, plain)) return 2;
     load = now();
     ok = load_scene(&s, scene) && (!size || set_size(&s, size));
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
     if (depth) s.depth = depth;
+    s.gamma = gamma;
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
@@ -2055,7 +2255,7 @@ int main(int argc, char **argv)
     t0 = now();
     render(&s, &o, img, &st);
     t0 = now() - t0;
-    ok = write_ppm(&out, img, s.w, s.h, plain);
+    ok = write_image(&out, img, s.w, s.h, plain, gamma);
     if (stats) print_stats(&s, &st, o.spp, load, build, t0);
     free(img);
     free(auto_name);
