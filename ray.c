@@ -473,9 +473,10 @@ static unsigned char to_byte(real v)
     return x > 255 ? 255 : (unsigned char)x;
 }
 
-/* Linear radiance to the sRGB curve (IEC 61966-2-1), for a path-traced
- * image on an ordinary display.  Whitted's images stay linear, as the card
- * prints them. */
+/* Linear light to the sRGB transfer curve (IEC 61966-2-1), which image
+ * viewers assume a PPM or PNG holds: a straight line near black, then a
+ * 1/2.4 power.  A path-traced image always gets it; Whitted's only with
+ * --gamma, so that the card's bytes stay the card's. */
 static real srgb(real v)
 {
     return v <= (real)0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
@@ -2560,13 +2561,180 @@ static int load_scene(Scene *s, const char *file)
 
 /* ------------------------------------------------------------------ output */
 
+/* Does name end with ext (given in lower case), in any case? */
+static int has_extension(const char *name, const char *ext)
+{
+    size_t n = strlen(name), k = strlen(ext), i;
+    if (n < k) return 0;
+    for (i = 0; i < k; i++)
+        if (tolower((unsigned char)name[n - k + i]) != ext[i]) return 0;
+    return 1;
+}
+
+enum { FORMAT_PPM, FORMAT_PNG, FORMAT_PFM, FORMAT_OTHER };
+
+/* The format -o asks for, by its extension: .png is PNG, .pfm PFM (floats,
+ * the radiance itself); anything else is
+ * PPM (.ppm, stdout, a device, a name without an extension), except the
+ * image formats this program cannot write, which are refused rather than
+ * given a PPM under their name. */
+static int output_format(const char *name)
+{
+    static const char *const other[] = { ".jpg", ".jpeg", ".gif", ".bmp", ".tif", ".tiff",
+                                         ".webp", ".tga", ".exr", ".hdr" };
+    size_t i;
+    if (has_extension(name, ".png")) return FORMAT_PNG;
+    if (has_extension(name, ".pfm")) return FORMAT_PFM;
+    for (i = 0; i < sizeof other / sizeof *other; i++)
+        if (has_extension(name, other[i])) return FORMAT_OTHER;
+    return FORMAT_PPM;
+}
+
+/* PNG (ISO/IEC 15948) without a compressor: the rows, each after filter
+ * byte 0 ("none"), make a zlib stream (RFC 1950) of stored deflate blocks
+ * (RFC 1951: a block's bytes as they are, after their count and its
+ * complement), one IDAT chunk per block.  Each chunk ends with the CRC-32
+ * of its type and data; the zlib stream ends with the Adler-32 of the rows. */
+#define STORED_MAX 65535                  /* the most bytes a stored block holds */
+
+typedef struct {
+    FILE *f;
+    unsigned long crc[256];               /* CRC-32 of each byte value */
+    unsigned long a, b;                   /* Adler-32's two sums */
+    unsigned char buf[2 + 5 + STORED_MAX + 4]; /* one IDAT chunk's data */
+    size_t n, start;                      /* bytes in buf; where the block's bytes start */
+} Png;
+
+/* The table of CRC-32 (the polynomial of ISO 3309, bits reversed). */
+static void crc_table(unsigned long t[256])
+{
+    unsigned long c;
+    int n, k;
+    for (n = 0; n < 256; n++) {
+        for (c = (unsigned long)n, k = 0; k < 8; k++) c = c & 1 ? 0xEDB88320UL ^ c >> 1 : c >> 1;
+        t[n] = c;
+    }
+}
+
+static unsigned long crc_update(const unsigned long t[256], unsigned long crc,
+                                const unsigned char *p, size_t n)
+{
+    while (n--) crc = t[(crc ^ *p++) & 0xFF] ^ crc >> 8;
+    return crc;
+}
+
+/* Four bytes, most significant first, as PNG and zlib store numbers. */
+static void put32(unsigned char *p, unsigned long v)
+{
+    p[0] = (unsigned char)(v >> 24 & 0xFF);
+    p[1] = (unsigned char)(v >> 16 & 0xFF);
+    p[2] = (unsigned char)(v >> 8 & 0xFF);
+    p[3] = (unsigned char)(v & 0xFF);
+}
+
+/* One chunk: its length, type, data and CRC. */
+static void png_chunk(Png *png, const char *type, const unsigned char *data, size_t n)
+{
+    unsigned char head[8], tail[4];
+    put32(head, (unsigned long)n);
+    memcpy(head + 4, type, 4);
+    put32(tail, crc_update(png->crc, crc_update(png->crc, 0xFFFFFFFFUL, head + 4, 4), data, n)
+                    ^ 0xFFFFFFFFUL);
+    fwrite(head, 1, 8, png->f);
+    fwrite(data, 1, n, png->f);
+    fwrite(tail, 1, 4, png->f);
+}
+
+/* The block in buf as an IDAT chunk; the last one also closes the zlib
+ * stream with its Adler-32.  The next block's header goes at buf[0]. */
+static void png_block(Png *png, int last)
+{
+    size_t len = png->n - png->start;
+    unsigned char *head = png->buf + png->start - 5;
+    head[0] = (unsigned char)last;        /* BFINAL, and BTYPE 00: stored */
+    head[1] = (unsigned char)(len & 0xFF);
+    head[2] = (unsigned char)(len >> 8);
+    head[3] = (unsigned char)(~len & 0xFF);
+    head[4] = (unsigned char)(~len >> 8 & 0xFF);
+    if (last) {
+        put32(png->buf + png->n, png->b << 16 | png->a);
+        png->n += 4;
+    }
+    png_chunk(png, "IDAT", png->buf, png->n);
+    png->n = png->start = 5;
+}
+
+/* Bytes of the rows into the zlib stream, a stored block at a time. */
+static void png_put(Png *png, const unsigned char *p, size_t n)
+{
+    while (n > 0) {
+        size_t room = STORED_MAX - (png->n - png->start), k = n < room ? n : room, i;
+        if (room == 0) { png_block(png, 0); continue; }
+        for (i = 0; i < k; i++) {
+            png->a = (png->a + p[i]) % 65521;
+            png->b = (png->b + png->a) % 65521;
+        }
+        memcpy(png->buf + png->n, p, k);
+        png->n += k;
+        p += k;
+        n -= k;
+    }
+}
+
+/* An 8-bit RGB PNG; with srgb, it says its bytes are sRGB (the sRGB chunk,
+ * and gAMA 1/2.2 for readers that know only that). 0: out of memory. */
+static int write_png(FILE *f, const unsigned char *img, int w, int h, int srgb)
+{
+    static const unsigned char signature[8] = { 137, 'P', 'N', 'G', 13, 10, 26, 10 };
+    unsigned char ihdr[13] = { 0 }, zero = 0, gamma[4];
+    Png *png = malloc(sizeof *png);
+    int j;
+    if (!png) return 0;
+    png->f = f;
+    crc_table(png->crc);
+    png->a = 1;
+    png->b = 0;
+    png->buf[0] = 0x78;                   /* zlib: deflate, 32K window; */
+    png->buf[1] = 0x01;                   /* 0x7801 is a multiple of 31 */
+    png->n = png->start = 2 + 5;
+    fwrite(signature, 1, 8, f);
+    put32(ihdr, (unsigned long)w);
+    put32(ihdr + 4, (unsigned long)h);
+    ihdr[8] = 8;                          /* bits per channel */
+    ihdr[9] = 2;                          /* RGB; compression, filter, interlace 0 */
+    png_chunk(png, "IHDR", ihdr, 13);
+    if (srgb) {
+        put32(gamma, 45455);
+        png_chunk(png, "sRGB", &zero, 1); /* rendering intent 0, perceptual */
+        png_chunk(png, "gAMA", gamma, 4);
+    }
+    for (j = 0; j < h; j++) {
+        png_put(png, &zero, 1);           /* filter type 0, none */
+        png_put(png, img + (size_t)3 * w * j, (size_t)3 * w);
+    }
+    png_block(png, 1);
+    png_chunk(png, "IEND", png->buf, 0);
+    free(png);
+    return 1;
+}
+
+static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain)
+{
+    size_t i, n = (size_t)w * h * 3;
+    fprintf(f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
+    if (plain)
+        for (i = 0; i < n; i += 3) fprintf(f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
+    else
+        fwrite(img, 1, n, f);
+}
+
 /* Where the image goes.  It is opened before the render, so that a bad -o
  * fails at once rather than after a long render.  A new or plain file is
  * written as FILE.tmp and renamed over FILE at the end, so that a failure
  * never leaves a half-written image behind.  Anything else (stdout, a device
  * such as /dev/null, a pipe, a symbolic link) is written in place and never
  * renamed over or removed. */
-typedef struct { FILE *f; const char *name; char *tmp; } Output;
+typedef struct { FILE *f; const char *name; char *tmp; int format; } Output;
 
 #ifdef RAY_POSIX
 /* Absent, or a plain file (not a link, a device or a pipe)? */
@@ -2584,6 +2752,7 @@ static int open_output(Output *o, const char *name)
     o->name = name;
     o->tmp = NULL;
     o->f = stdout;
+    o->format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
     if (!strcmp(name, "-")) return 1;
     if (replaceable(name)) {
         o->tmp = malloc(strlen(name) + 5);
@@ -2607,16 +2776,6 @@ static void discard_output(Output *o)
     free(o->tmp);
 }
 
-static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain)
-{
-    size_t i, n = (size_t)w * h * 3;
-    fprintf(f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
-    if (plain)
-        for (i = 0; i < n; i += 3) fprintf(f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
-    else
-        fwrite(img, 1, n, f);
-}
-
 /* PFM, netpbm's floating-point format: "PF" (colour), the size, and -1 for
  * little-endian floats; then the rows from the bottom up. */
 static void write_pfm(FILE *f, const Image *img)
@@ -2634,11 +2793,20 @@ static void write_pfm(FILE *f, const Image *img)
         }
 }
 
-/* Finishes an output: flushed and closed, and the temporary file renamed
- * over the name asked for. */
-static int close_output(Output *o)
+/* The image in the output's format, then the file closed and, if it was
+ * written as a temporary, renamed into place; on failure a message and no
+ * file.  A PNG of sRGB bytes says so. */
+static int write_image(Output *o, const Image *img, int plain)
 {
-    int ok = fflush(o->f) == 0 && !ferror(o->f);
+    int ok = 1;
+    errno = 0;
+    if (o->format == FORMAT_PFM) write_pfm(o->f, img);
+    else if (o->format == FORMAT_PNG) {
+        ok = write_png(o->f, img->bytes, img->w, img->h, img->srgb);
+        if (!ok) errno = ENOMEM;
+    } else
+        write_ppm(o->f, img->bytes, img->w, img->h, plain);
+    ok = ok && fflush(o->f) == 0 && !ferror(o->f);
     if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
     if (ok && o->tmp) ok = rename(o->tmp, o->name) == 0;
     if (!ok) {
@@ -2649,14 +2817,6 @@ static int close_output(Output *o)
     return ok;
 }
 
-/* The image as PPM (bytes: binary P6, or plain P3), or as PFM (floats). */
-static int write_image(Output *o, const Image *img, int plain)
-{
-    if (img->floats) write_pfm(o->f, img);
-    else write_ppm(o->f, img->bytes, img->w, img->h, plain);
-    return close_output(o);
-}
-
 /* ------------------------------------------------------------ command line */
 
 static void usage(FILE *to)
@@ -2665,8 +2825,8 @@ static void usage(FILE *to)
           "Renders SCENE with Whitted ray tracing, or path tracing (--pt): the sphere\n"
           "format (README.md), or NFF (Eric Haines' Neutral File Format, the SPD\n"
           "scenes') when it ends .nff.\n"
-          "  -o FILE    output image: PPM, or PFM (floats) when it ends .pfm\n"
-          "             (default: SCENE's base name + .ppm; - for stdout)\n"
+          "  -o FILE    output image: PNG if FILE ends .png, PFM (floats) if .pfm, else\n"
+          "             PPM (default: SCENE's base name + .ppm; - for stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
           "  -n N       samples per pixel (default: the scene's `samples`, else 1)\n"
           "  -d N       Whitted: recursion depth, 1 = primary rays only (default: the\n"
@@ -2680,6 +2840,7 @@ static void usage(FILE *to)
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
           "  --seed N   the path tracer's noise (default 0): another N, other noise\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
+          "  --gamma    encode the output with the sRGB curve (default: linear, as the card)\n"
           "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
           "             the tree from 8 objects up)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
@@ -2697,6 +2858,19 @@ static int int_arg(const char *opt, const char *arg, int max)
         exit(2);
     }
     return (int)v;
+}
+
+/* Can -o FILE be written as asked?  Else a message (a usage error). */
+static int output_usable(const char *name, int plain)
+{
+    int format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
+    if (format == FORMAT_OTHER)
+        fprintf(stderr, "ray: cannot write %s: the formats are PPM, PNG and PFM (-o x.ppm, x.png, x.pfm)\n",
+                name);
+    else if (format != FORMAT_PPM && plain)
+        fprintf(stderr, "ray: --p3 is a PPM form; %s is a %s\n", name,
+                format == FORMAT_PNG ? "PNG" : "PFM");
+    return format == FORMAT_PPM || (format != FORMAT_OTHER && !plain);
 }
 
 static char *default_output(const char *scene)
@@ -2800,18 +2974,8 @@ static int settle_path_options(Scene *s, int integrator, int estimator, int roul
     return 1;
 }
 
-/* Whether name ends with the suffix, in any case. */
-static int ends_with(const char *name, const char *suffix)
-{
-    size_t n = strlen(name), k = strlen(suffix), i;
-    if (n < k) return 0;
-    for (i = 0; i < k; i++)
-        if (tolower((unsigned char)name[n - k + i]) != tolower((unsigned char)suffix[i])) return 0;
-    return 1;
-}
-
 /* An image of w x h pixels, floats or bytes (through the sRGB curve for a
- * path-traced one). */
+ * path-traced one, and with --gamma). */
 static int new_image(Image *img, int w, int h, int floats, int srgb)
 {
     img->w = w;
@@ -2847,7 +3011,8 @@ int main(int argc, char **argv)
     Image img;
     const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
     char *auto_name = NULL;
-    int i, depth = 0, plain = 0, stats = 0, ok, integrator = -1, estimator = -1, roulette = 1;
+    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, integrator = -1, estimator = -1;
+    int roulette = 1;
     long seed = -1;
     double t0, load, build;
 
@@ -2860,6 +3025,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "-d")) { depth = int_arg(a, next, 64); i++; }
         else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
         else if (!strcmp(a, "--p3")) plain = 1;
+        else if (!strcmp(a, "--gamma")) gamma = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
         else if (!strcmp(a, "--accel") && next
                  && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
@@ -2882,6 +3048,7 @@ int main(int argc, char **argv)
         else scene = a;
     }
     if (!scene) { usage(stderr); return 2; }
+    if (name && !output_usable(name, plain)) return 2;
     load = now();
     ok = load_scene(&s, scene) && (!size || set_size(&s, size));
     load = now() - load;
@@ -2895,7 +3062,7 @@ int main(int argc, char **argv)
     if (ok && !name) name = auto_name = default_output(scene);
     if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
 
-    if (!new_image(&img, s.w, s.h, ends_with(name, ".pfm"), s.integrator == PATH)) {
+    if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, s.integrator == PATH || gamma)) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h);
         discard_output(&out);
         free_scene(&s); free(auto_name);
