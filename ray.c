@@ -2910,15 +2910,19 @@ static int build_accel(Scene *s, const char *accel)
 }
 
 static void print_stats(const Scene *s, const Counts *st, int spp, double load, double build,
-                        double seconds)
+                        double seconds, double cpu)
 {
     static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
                                               "MIS (BSDF sampling and next-event estimation)" };
     unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted + st->bounced;
     fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d lights; read in %.3f s\n",
             s->nsph, s->ncone, s->ntri, s->nlight, load);
-    fprintf(stderr, "image      %dx%d, %d spp, depth %d, %d thread%s\n", s->w, s->h, spp, s->depth,
-            st->threads, st->threads == 1 ? "" : "s");
+    if (s->integrator == PATH)
+        fprintf(stderr, "image      %dx%d, %d spp, path traced, %d thread%s\n", s->w, s->h, spp,
+                st->threads, st->threads == 1 ? "" : "s");
+    else
+        fprintf(stderr, "image      %dx%d, %d spp, depth %d, %d thread%s\n", s->w, s->h, spp,
+                s->depth, st->threads, st->threads == 1 ? "" : "s");
     if (s->accel == ACCEL_KD) {
         kd_info k;
         kd_describe(s->kd, &k);
@@ -2945,8 +2949,8 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
     fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
             st->queries ? (double)st->tests / st->queries : 0.0,
             st->queries ? (double)st->steps / st->queries : 0.0);
-    fprintf(stderr, "time       %.3f s, %.2f Mrays/s\n", seconds,
-            seconds > 0 ? rays / seconds * 1e-6 : 0.0);
+    fprintf(stderr, "time       %.3f s, %.2f Mrays/s (CPU %.3f s, all threads)\n", seconds,
+            seconds > 0 ? rays / seconds * 1e-6 : 0.0, cpu);
 }
 
 static void free_scene(Scene *s)
@@ -3015,6 +3019,7 @@ int main(int argc, char **argv)
     int roulette = 1;
     long seed = -1;
     double t0, load, build;
+    clock_t c0;
 
     for (i = 1; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -3072,10 +3077,11 @@ int main(int argc, char **argv)
     memset(&st, 0, sizeof st);
     if (s.integrator == PATH && s.warning[0]) fprintf(stderr, "%s\n", s.warning);
     t0 = now();
+    c0 = clock();
     render(&s, &o, &img, &st);
     t0 = now() - t0;
     ok = write_image(&out, &img, plain);
-    if (stats) print_stats(&s, &st, o.spp, load, build, t0);
+    if (stats) print_stats(&s, &st, o.spp, load, build, t0, (double)(clock() - c0) / CLOCKS_PER_SEC);
     free(img.bytes);
     free(img.floats);
     free(auto_name);

@@ -1,0 +1,10 @@
+#!/usr/bin/env bash
+# Renders the path-traced scenes for the README's gallery:
+#     make && bash tools/render_pt.sh
+# Each scene at its own size and samples (its `size` and `samples` lines),
+# on every core; prints each render's time from --stats, wall and CPU.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+for s in cornell smallpt caustic bleed; do
+  ./ray --stats -o "docs/pt/$s.png" "scenes/$s.sph" 2>&1 | grep -E '^(image|time)' | sed "s/^/$s: /"
+done
