@@ -216,85 +216,61 @@ static void test_sphere_is_point(void)
     }
 }
 
-/* ---- lossless objects vanish in a white room ---- */
+/* ---- one ball under a uniform sky ---- */
 
-/* In a uniform environment of radiance 1, a perfect mirror and a glass ball
- * without absorption return 1 along every ray: what the glass lets in, it
- * lets out (the eta^2 of radiance entering and leaving cancel), and what
- * Fresnel reflects, the mirror keeps.  A camera sees a sphere filling most
- * of the view. */
-static void test_lossless(void)
+/* The mean radiance seen by a camera (eye, looking at `at`, fov) of one
+ * unit ball at the origin under a uniform sky of radiance L, with material
+ * kd ks kt (white, index 1.5), by estimator e; n samples. */
+static Stat ball_in_sky(double L, double kd, double ks, double kt, vec eye, vec at, double fov,
+                        int e, int n)
 {
-    int e, glass;
+    Scene s;
+    Stat st;
+    default_scene(&s);
+    s.w = s.h = 8;
+    s.background = v3(L, L, L);
+    add_sphere(&s, v3(0, 0, 0), 1, material(&s, v3(1, 1, 1), kd, ks, kt, 0, 1.5, 0));
+    camera(&s, eye, at, v3(0, 0, 1), fov);
+    ready(&s, e, 1, 0);
+    st = image_samples(&s, n, 1);
+    free_scene(&s);
+    return st;
+}
+
+/* The three checks that use it: each names the ball, its material and the
+ * answer, for every estimator. */
+static void sky_checks(void)
+{
+    static const struct { const char *name; double L, kd, ks, kt; vec eye, at; double fov, want; } c[] = {
+        /* A perfect mirror and a glass ball without absorption return the
+         * room's radiance along every ray: what the glass lets in, it lets
+         * out (the eta^2 of radiance entering and leaving cancel), and
+         * what Fresnel reflects, the mirror keeps. */
+        { "a mirror ball in a white room vanishes", 1, 0, 1, 0, { 0, -4, 0.3 }, { 0, 0, 0 }, 30, 1 },
+        { "a glass ball in a white room vanishes", 1, 0, 0, 1, { 0, -4, 0.3 }, { 0, 0, 0 }, 30, 1 },
+        /* Inside glass of index n the room is n^2 times brighter: radiance
+         * crowds into a narrower cone entering a denser medium (L / n^2 is
+         * what a ray keeps), and every path from a camera inside leaves the
+         * ball once more than it enters: the check on sample_glass's eta^2
+         * that the vanishing ball cannot make (in and out again, the two
+         * factors cancel whatever they are). */
+        { "inside a glass ball (n = 1.5) a white room is n^2 = 2.25 times brighter", 1, 0, 0, 1,
+          { 0.2, 0.1, -0.3 }, { 1, 0.5, 0 }, 90, 2.25 },
+        /* A convex Lambertian ball of albedo a under a sky of radiance L
+         * sees only sky: it reflects a L, the sky sampled and weighed as a
+         * light by each estimator. */
+        { "a white ball of albedo 0.6 under a sky of 0.8 reflects 0.48", 0.8, 0.6, 0, 0,
+          { 0, -3, 0.4 }, { 0, 0, 0 }, 20, 0.48 },
+    };
+    int k, e;
     char name[160];
-    for (glass = 0; glass < 2; glass++)
+    for (k = 0; k < (int)(sizeof c / sizeof c[0]); k++)
         for (e = 0; e < 3; e++) {
-            Scene s;
-            Stat st;
-            default_scene(&s);
-            s.w = s.h = 16;
-            s.background = v3(1, 1, 1);
-            add_sphere(&s, v3(0, 0, 0), 1,
-                       material(&s, v3(1, 1, 1), 0, glass ? 0 : 1, glass ? 1 : 0, 0, 1.5, 0));
-            camera(&s, v3(0, -4, 0.3), v3(0, 0, 0), v3(0, 0, 1), 30);
-            ready(&s, e, 1, 0);
-            st = image_samples(&s, 40000, 2);
-            sprintf(name, "a %s ball in a white room vanishes, %s", glass ? "glass" : "mirror",
-                    est_name[e]);
-            report(agrees(&st, 1), name, "%.6f +- %.6f, want 1", stat_mean(&st), stat_se(&st));
-            free_scene(&s);
+            Stat st = ball_in_sky(c[k].L, c[k].kd, c[k].ks, c[k].kt, c[k].eye, c[k].at, c[k].fov, e, 30000);
+            sprintf(name, "%s, %s", c[k].name, est_name[e]);
+            report(agrees(&st, c[k].want), name, "%.6f +- %.6f, want %g", stat_mean(&st), stat_se(&st),
+                   c[k].want);
         }
-}
-
-/* Inside glass of index n, a white room's radiance is n^2 times brighter:
- * radiance crowds into a narrower cone entering a denser medium (L / n^2 is
- * what is kept along a ray).  A camera inside a glass ball: every path
- * leaves the ball once more than it enters it.  This is the check on the
- * eta^2 of sample_glass that the vanishing ball above cannot make (in and
- * out again, the factors cancel whatever they are). */
-static void test_inside_glass(void)
-{
-    int e;
-    char name[160];
-    for (e = 0; e < 3; e++) {
-        Scene s;
-        Stat st;
-        default_scene(&s);
-        s.w = s.h = 8;
-        s.background = v3(1, 1, 1);
-        add_sphere(&s, v3(0, 0, 0), 1, material(&s, v3(1, 1, 1), 0, 0, 1, 0, 1.5, 0));
-        camera(&s, v3(0.2, 0.1, -0.3), v3(1, 0.5, 0), v3(0, 0, 1), 90);
-        ready(&s, e, 1, 0);
-        st = image_samples(&s, 20000, 0);
-        sprintf(name, "inside a glass ball (n = 1.5) the white room is n^2 = 2.25 times brighter, %s",
-                est_name[e]);
-        report(agrees(&st, 2.25), name, "%.6f +- %.6f, want 2.25", stat_mean(&st), stat_se(&st));
-        free_scene(&s);
-    }
-}
-
-/* A convex Lambertian ball of albedo a under a uniform sky of radiance L
- * reflects a L everywhere (nothing else is seen from its surface): the
- * sky as a light, sampled and weighed by each estimator. */
-static void test_sky(void)
-{
-    double a = 0.6, L = 0.8;
-    int e;
-    char name[160];
-    for (e = 0; e < 3; e++) {
-        Scene s;
-        Stat st;
-        default_scene(&s);
-        s.w = s.h = 8;
-        s.background = v3(L, L, L);
-        add_sphere(&s, v3(0, 0, 0), 1, material(&s, v3(1, 1, 1), a, 0, 0, 0, 1, 0));
-        camera(&s, v3(0, -3, 0.4), v3(0, 0, 0), v3(0, 0, 1), 20);
-        ready(&s, e, 1, 0);
-        st = image_samples(&s, 20000, 0);
-        sprintf(name, "a white ball under a uniform sky: L = albedo x sky, %s", est_name[e]);
-        report(agrees(&st, a * L), name, "%.6f +- %.6f, want %g", stat_mean(&st), stat_se(&st), a * L);
-        free_scene(&s);
-    }
 }
 
 /* ---- the BSDFs ---- */
@@ -604,9 +580,7 @@ int main(void)
     test_furnace();
     test_point_in_sphere();
     test_sphere_is_point();
-    test_lossless();
-    test_inside_glass();
-    test_sky();
+    sky_checks();
     test_estimators_agree();
     test_seed();
     return failures != 0;
