@@ -1,15 +1,22 @@
 /* ray.c - the lecture "Ray Tracing + Global Illumination" as one C file:
- * Whitted's recursive ray tracer, spheres, cones and triangles, and the
- * kd-tree (kdtree.c) that finds their hits.
+ * Whitted's recursive ray tracer and Kajiya's path tracer side by side,
+ * spheres, cones and triangles, and the kd-tree (kdtree.c) that finds hits.
  *
  *     make && ./ray -s 640x480 -n 4 scenes/whitted.sph      (writes whitted.ppm)
+ *     ./ray scenes/cornell.sph                              (path traced)
  *
  * Usage: ./ray [options] SCENE
- *     -o FILE     output image (default: SCENE's base name with .ppm; - = stdout)
+ *     -o FILE     output image: PPM, PNG (.png) or PFM floats (.pfm)
+ *                 (default: SCENE's base name with .ppm; - = stdout)
  *     -s WxH      image size (default: the scene's, else 512x512)
- *     -n N        anti-aliasing samples per pixel (default 1)
- *     -d N        recursion depth; 1 = primary rays only (default: scene's, else 5)
+ *     -n N        samples per pixel (default: the scene's, else 1)
+ *     -d N        Whitted: recursion depth, 1 = primary rays only (default:
+ *                 scene's, else 5); path tracing: the rays of a path at most
  *     -t N        threads (default: every core, when built with OpenMP)
+ *     --pt, --whitted   path tracing or Whitted (default: the scene's, else Whitted)
+ *     --estimator E     bsdf, nee or mis (default), for the path tracer
+ *     --no-roulette, --seed N     for the path tracer
+ *     --gamma     the sRGB curve on Whitted's output (path tracing always has it)
  *     --p3        plain-text PPM (P3) instead of binary (P6)
  *     --accel A   kd (the kd-tree of kdtree.c), none (test every object), or
  *                 auto (default: the tree once there are 8 objects or more)
@@ -20,7 +27,8 @@
  *
  * HOW TO READ IT.  The lecture comes first, in the order a ray meets it:
  * the types, the vectors, a table of contents (the prototypes), then
- * "for each pixel", RayTrace(R), finding hits, and the primitives.  After
+ * "for each pixel", RayTrace(R) (Whitted), L = Le + integral f L cos
+ * (Kajiya), finding hits, and the primitives.  After
  * the line THE PLUMBING come threads, scene files, output and main(); a
  * student can stop reading there.
  *
@@ -41,7 +49,15 @@
  *             reflected ray Refl               reflect(); colour += RayTrace(Refl)
  *             refracted ray (Snell)            refract(); colour += RayTrace(Refr)
  *
- * One primary ray, from main() to its pixel's byte.  Each function is
+ * and the rendering equation (Kajiya 1986), for the path tracer:
+ *
+ *     pixel = mean of L over random points      pixel_radiance(), sample_radiance()
+ *     L(x, wo) = Le(x, wo)                      radiance(): emitted()
+ *              + integral of f Li cos               sample_light() (direct), and
+ *                                                   sample_bsdf(): f cos / pdf times
+ *                                                   Li = radiance() of the next point
+ *
+ * One primary ray of Whitted's, from main() to its pixel's byte.  Each function is
  * defined below the one before it, except the seven marked ^, which a
  * reader finds further up:
  *
@@ -2840,7 +2856,8 @@ static void usage(FILE *to)
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
           "  --seed N   the path tracer's noise (default 0): another N, other noise\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
-          "  --gamma    encode the output with the sRGB curve (default: linear, as the card)\n"
+          "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
+          "             card's; a path-traced image always has it, but for PFM)\n"
           "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
           "             the tree from 8 objects up)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
