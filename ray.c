@@ -198,6 +198,7 @@ typedef struct {
     int spp;                  /* samples per pixel the scene asks for (0: none said) */
     int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
     int roulette;             /* 1: Russian roulette ends paths */
+    int tir_reflect;          /* Whitted: past the critical angle kt goes to the mirror */
     int max_rays;             /* rays on a path at most (-d); 0: no bound but roulette */
     unsigned seed;            /* --seed: which noise */
     Emitter *emit;  int nemit;  /* the path tracer's lights */
@@ -205,6 +206,7 @@ typedef struct {
     real *emit_cdf;           /* emit_cdf[i]: chance of choosing one of lights 0..i */
     int *emitter;             /* emitter[object]: its light, or -1 */
     char warning[256];        /* said once when the path tracer starts, if set */
+    char whitted_warning[256];  /* the same for Whitted's */
     int accel;                /* which structure finds hits: ACCEL_NONE or ACCEL_KD */
     kd_tree *kd;              /* the kd-tree, when accel is ACCEL_KD */
     prims prims;              /* how the structure sees the objects (prims.h) */
@@ -251,6 +253,7 @@ typedef struct {
     unsigned long long queries, nearest, hits;  /* all queries; nearest-hit ones; their hits */
     unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
     unsigned long long bounced, discarded;      /* path tracer: BSDF-sampled rays; bad samples */
+    unsigned long long cut;                     /* Whitted: rays past a primary ray's budget */
     int threads;                                /* how many threads rendered */
 } Counts;
 
@@ -261,11 +264,13 @@ typedef struct {
  * which costs cache hits but never changes an answer), and where the path
  * tracer's random numbers stand. */
 #define SHADOW_SLOTS 8
+#define RAY_BUDGET 1024         /* reflected and refracted rays a primary ray may spawn */
 typedef struct {
     Counts count;
     int blocker[SHADOW_SLOTS];  /* light i's last blocker, or -1, in slot i % SHADOW_SLOTS */
     unsigned long long key;     /* the path tracer's random numbers: which sample, */
     unsigned dim;               /* and how many it has drawn (see random01) */
+    int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
 } Worker;
 
 /* The image being made: bytes (for PPM), or floats (for PFM), row by row
@@ -338,7 +343,7 @@ static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
 static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Worker *wk);
 static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real *e,
                       vec *to_light, Worker *wk);
-static int worth_tracing(real k, real weight, int depth);
+static int worth_tracing(real k, real weight, int depth, Worker *wk);
 static vec reflect(vec d, vec n, real cosi);
 static int refract(vec d, vec n, real cosi, real eta, vec *t);
 
@@ -429,6 +434,7 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
         real dx, dy;
         sample_offset(k, s->cam.anchor, &dx, &dy);
         wk->count.primary++;
+        wk->budget = RAY_BUDGET;
         sum = add(sum, trace(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), s->depth, 1, wk));
     }
     return scale((real)1 / spp, sum);
@@ -518,10 +524,15 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
 {
     const Material *m = &s->mat[h->mat];
     vec n = h->n, color = s->ambient, spec = v3(0, 0, 0), c, t, mirror, dir;
-    real cosi = -dot(r.d, n), eta = 1 / m->ir, e;
-    int i;
+    real cosi = -dot(r.d, n), eta = 1 / m->ir, e, kr;
+    int i, tir;
     if (dot(r.d, h->ng) > 0) { n = scale(-1, n); cosi = -cosi; eta = m->ir; } /* inside */
     mirror = reflect(r.d, n, cosi);
+    /* Past the critical angle no refracted ray exists.  The card then loses
+     * the kt share (its glass goes black there); the SPD's rule, and with
+     * `tir reflect` a sphere file's, sends it into the reflected ray. */
+    tir = m->kt > 0 && !refract(r.d, n, cosi, eta, &t);
+    kr = tir && s->tir_reflect ? m->ks + m->kt : m->ks;
     for (i = 0; i < s->nlight; i++)
         if (shadow_ray(s, h, n, &s->light[i], &e, &dir, wk)) {
             color = comb(e, s->light[i].color, color);
@@ -538,11 +549,11 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
     c = scale(m->kl, m->color);                 /* emission */
     c = comb(m->kd, color, c);                  /* diffuse */
     if (m->shine > 0) c = comb(m->ks, spec, c); /* highlight */
-    if (worth_tracing(m->ks, weight, depth)) {
+    if (worth_tracing(kr, weight, depth, wk)) {
         wk->count.reflected++;
-        c = comb(m->ks, trace(s, spawn(s, h, mirror), depth - 1, m->ks * weight, wk), c);
+        c = comb(kr, trace(s, spawn(s, h, mirror), depth - 1, kr * weight, wk), c);
     }
-    if (worth_tracing(m->kt, weight, depth) && refract(r.d, n, cosi, eta, &t)) {
+    if (!tir && worth_tracing(m->kt, weight, depth, wk)) {
         wk->count.refracted++;
         c = comb(m->kt, trace(s, spawn(s, h, t), depth - 1, m->kt * weight, wk), c);
     }
@@ -575,11 +586,20 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
  * half a step of an 8-bit channel, where it can hardly change a byte: Hall
  * and Greenberg's adaptive depth (1983).  Without it, two facing mirrors or
  * nested glass double the rays at every level, and -d 30 takes days; with
- * it, minray's scene and depth 3 never come near the limit. */
+ * it, minray's scene and depth 3 never come near the limit.
+ * The weight bounds one path, not how many there are: where ks + kt is near
+ * 2 (glass that is also a mirror) every ray still spawns two, 2^depth in
+ * all.  So a primary ray's tree also has a budget, RAY_BUDGET reflected and
+ * refracted rays, spent depth first; what it cannot pay for is not traced
+ * and is counted (--stats).  Ordinary scenes never reach it: depth 5, the
+ * SPD's, allows at most 30. */
 #define MIN_WEIGHT (1.0 / 512)
-static int worth_tracing(real k, real weight, int depth)
+static int worth_tracing(real k, real weight, int depth, Worker *wk)
 {
-    return k > 0 && depth > 1 && k * weight >= MIN_WEIGHT;
+    if (!(k > 0 && depth > 1 && k * weight >= MIN_WEIGHT)) return 0;
+    if (wk->budget > 0) { wk->budget--; return 1; }
+    wk->count.cut++;
+    return 0;
 }
 
 /* The mirror direction of d about the normal n, where cosi = -d.n > 0. */
@@ -1556,7 +1576,10 @@ static int watertight_inside(vec a, vec b, vec c, const Ray *r)
  *    outside every triangle there.  When a bound fails by less than 1e-7 of
  *    det (far below any visible distance, far above the rounding error),
  *    the exact test watertight_inside() decides instead.  That is rare, so
- *    the common case keeps Moller and Trumbore's speed.
+ *    the common case keeps Moller and Trumbore's speed.  In the float build
+ *    (-DREAL=float) the rounding of u and v grows with the ray's distance
+ *    beyond 1e-7 of det (a mesh seen from afar showed holes), so there the
+ *    margin also covers a bound on that: 96 ulps of |o - v0| |d| |e|.
  * Returns 1 and t, u, v (barycentrics of v1 and v2) on a hit. */
 static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
                         real *t, real *u, real *v)
@@ -1569,8 +1592,10 @@ static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real t
     } else if (det == 0)                 /* the non-culling branch */
         return 0;
     det *= sign;                         /* from here on det > 0 */
-    slack = (real)1e-7 * det;
     tv = sub(r->o, v0);                   /* u, v and t, each times det */
+    slack = (real)1e-7 * det;
+    if (sizeof(real) == sizeof(float))   /* see above: float's rounding outgrows 1e-7 */
+        slack += 96 * REAL_EPS * maxabs(tv) * maxabs(r->d) * (maxabs(e1) + maxabs(e2));
     uu = sign * dot(tv, p);
     if (uu < -slack || uu > det + slack) return 0;
     q = cross(tv, e1);
@@ -1678,12 +1703,23 @@ static real triangle_pdf(const Triangle *tr, real dist, real cosy)
 
 /* Zero area (a repeated vertex, or three in a line) to within rounding: such
  * a triangle has no inside and no normal, so it is never hit.  Relative to
- * the edge lengths, so that tiny but proper triangles stay. */
+ * the edge lengths, so that tiny but proper triangles stay.  In double even
+ * in the float build, where the product of four lengths would overflow past
+ * legs of 1e9 and vanish below 1e-11. */
 static int degenerate(vec a, vec b, vec c)
 {
-    vec e1 = sub(b, a), e2 = sub(c, a), n = cross(e1, e2);
-    real k = 64 * REAL_EPS * sqrt(dot(e1, e1) * dot(e2, e2));
-    return !(sqrt(dot(n, n)) > k);
+    double p[3][3], e1[3], e2[3], n[3], k;
+    int i;
+    to3(a, p[0]);
+    to3(b, p[1]);
+    to3(c, p[2]);
+    for (i = 0; i < 3; i++) e1[i] = p[1][i] - p[0][i], e2[i] = p[2][i] - p[0][i];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    k = 64 * REAL_EPS * sqrt((e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2])
+                             * (e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]));
+    return !(sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) > k);
 }
 
 /* =========================================================================
@@ -1731,6 +1767,7 @@ static void add_counts(Counts *to, const Counts *from)
     to->nearest += from->nearest;
     to->bounced += from->bounced;
     to->discarded += from->discarded;
+    to->cut += from->cut;
     if (from->threads > to->threads) to->threads = from->threads;
 }
 
@@ -2012,12 +2049,17 @@ static int check_cone(Scene *s, Where w, const real *x, int mat)
 }
 
 /* Remembers the first material whose kd + ks + kt exceeds 1, for the path
- * tracer's warning (Whitted's model takes such weights as they are). */
+ * tracer's warning, and the first whose ks + kt does, for Whitted's (its
+ * model takes such weights as they are). */
 static void note_weights(Scene *s, Where w, const Material *m)
 {
     if (m->kd + m->ks + m->kt > 1 && !s->warning[0])
         sprintf(s->warning, "%.100s:%d: warning: kd + ks + kt = %.3g exceeds 1; "
                 "the path tracer scales them to 1", w.file, w.line, (double)(m->kd + m->ks + m->kt));
+    if (m->ks + m->kt > 1 && !s->whitted_warning[0])
+        sprintf(s->whitted_warning, "%.100s:%d: warning: ks + kt = %.3g exceeds 1: what is "
+                "reflected and refracted grows at every bounce, light out of nothing", w.file, w.line,
+                (double)(m->ks + m->kt));
 }
 
 /* r g b kd ks kt kl ir: minray's material fields, for tri and mesh lines. */
@@ -2226,6 +2268,12 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
         if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
         if (!(v[0] >= 0)) return fail(w, "hither must be 0 or more", tok[1]);
         s->cam.hither = v[0];
+        return 1;
+    }
+    if (!strcmp(k, "tir")) {
+        if (ntok != 2 || (strcmp(tok[1], "reflect") && strcmp(tok[1], "black")))
+            return fail(w, "expected `tir reflect` or `tir black`", NULL);
+        s->tir_reflect = !strcmp(tok[1], "reflect");
         return 1;
     }
     if (!strcmp(k, "integrator")) {
@@ -2534,6 +2582,7 @@ static int load_nff(Scene *s, FILE *f, Where w)
     int mat = -1, k, ok = 1, got = 1;
     double intensity;
     lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.again = 0;
+    s->tir_reflect = 1;                          /* the SPD's rule */
     while (ok && (got = next_token(&lx)) > 0) {
         const char *t = lx.tok;
         if (mat < 0 && strchr("spc", t[0])) {    /* objects before any f: plain white */
@@ -2909,6 +2958,21 @@ static char *default_output(const char *scene)
  * (5 spheres) the loop is 25% faster. */
 #define TREE_FROM 8
 
+/* Whether every object lies within the range the kd-tree's float boxes and
+ * planes can hold (kdtree.c clamps beyond FLT_MAX), with float precision
+ * to spare: coordinates below 1e37, and a scene that reaches beyond 1e-30
+ * of the origin (nearer, floats lose their bits to denormals). */
+static int float_range(const Scene *s)
+{
+    double lo[3], hi[3], big = 0;
+    int i, a;
+    for (i = 0; i < nobj(s); i++) {
+        prim_bounds((void *)s, i, lo, hi);
+        for (a = 0; a < 3; a++) big = fmax(big, fmax(fabs(lo[a]), fabs(hi[a])));
+    }
+    return nobj(s) == 0 || (big < 1e37 && big > 1e-30);
+}
+
 /* The structure that answers nearest_hit and any_hit, as --accel says: the
  * kd-tree, none (every ray tests every object), or auto (the tree once the
  * scene has TREE_FROM objects). */
@@ -2920,6 +2984,12 @@ static int build_accel(Scene *s, const char *accel)
     s->prims.user = s;
     s->accel = ACCEL_NONE;
     if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
+    if (!float_range(s)) {
+        fprintf(stderr, "ray: warning: coordinates beyond the float range the kd-tree keeps its planes"
+                " in (above 1e37, or a scene within 1e-30 of the origin): every ray tests every"
+                " object instead\n");
+        return 1;
+    }
     s->kd = kd_build(nobj(s), &s->prims);
     if (!s->kd) { fprintf(stderr, "ray: out of memory for the kd-tree\n"); return 0; }
     s->accel = ACCEL_KD;
@@ -2961,6 +3031,9 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
     } else
         fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
                 rays, st->primary, st->shadow, st->reflected, st->refracted);
+    if (s->integrator != PATH && st->cut)
+        fprintf(stderr, "budget     %llu reflected or refracted rays not traced: past %d a primary ray\n",
+                st->cut, RAY_BUDGET);
     fprintf(stderr, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
             st->nearest ? 100.0 * st->hits / (double)st->nearest : 0.0);
     fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
@@ -3092,7 +3165,8 @@ int main(int argc, char **argv)
     }
     o.progress = stderr_is_terminal();
     memset(&st, 0, sizeof st);
-    if (s.integrator == PATH && s.warning[0]) fprintf(stderr, "%s\n", s.warning);
+    if (s.integrator == PATH ? s.warning[0] : s.whitted_warning[0])
+        fprintf(stderr, "%s\n", s.integrator == PATH ? s.warning : s.whitted_warning);
     t0 = now();
     c0 = clock();
     render(&s, &o, &img, &st);

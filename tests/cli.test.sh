@@ -121,3 +121,13 @@ printf 'camera 0 0 0 0 1 0 0 0 1 40\n0 4 0  1 1 1 1  0 .5 .5 0 1.5\n0 4 0  1 1 1
 start=$(date +%s)
 ./ray -s 32x32 -d 64 -o "$TMP/n.ppm" "$TMP/nested.sph"; rc=$?
 [ $rc -eq 0 ] && [ $(( $(date +%s) - start )) -lt 10 ] && ok "nested glass at depth 64 finishes" || bad "nested glass at depth 64: exit $rc"
+
+# Weights that make light out of nothing: ks = kt = 1 in two nested balls
+# finishes at depth 64 (each primary ray's tree stops at its budget, and
+# --stats counts what was cut), with one warning naming the file and line.
+printf 'camera 0 0 0 0 1 0 0 0 1 40\n0 4 0  1 1 1 1  0 1 1 0 1.3\n0 4 0  1 1 1 .5 0 1 1 0 1.3\nlight 0 0 5 1 1 1\n' > "$TMP/both.sph"
+./ray -s 8x8 -d 64 --stats -o "$TMP/b.ppm" "$TMP/both.sph" 2>"$TMP/err"; rc=$?
+[ $rc -eq 0 ] && [ "$(grep -c "both.sph:2: warning: ks + kt = 2 exceeds 1" "$TMP/err")" = 1 ] \
+  && grep -q "^budget .* not traced" "$TMP/err" \
+  && ok "ks + kt = 2 at depth 64: bounded by the ray budget, counted, one file:line warning" \
+  || bad "ks + kt = 2: exit $rc, $(head -c 300 "$TMP/err")"
