@@ -364,7 +364,7 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *
                           real *dist, vec *Le, real *pdf);
 static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny);
 static int front_emits(const Scene *s, int i, vec ng, vec wo);
-static Bsdf bsdf_at(const Scene *s, const Hit *h, vec wo);
+static void bsdf_at(const Scene *s, const Hit *h, vec wo, Bsdf *b);
 static vec bsdf_eval(const Bsdf *b, vec wo, vec wi);
 static real bsdf_pdf(const Bsdf *b, vec wo, vec wi);
 static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf);
@@ -734,7 +734,7 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
     if (!nearest_hit(s, r, &h, wk)) return sky(s, r.d, path);
     Le = emitted(s, &h, wo, path);
     if (path->rays == s->max_rays || path->rays == MAX_PATH) return Le;
-    b = bsdf_at(s, &h, wo);
+    bsdf_at(s, &h, wo, &b);
     direct = s->estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
     lobe = sample_bsdf(&b, wo, wk, &next.from, &f_cos, &pdf);   /* next.from: wi */
     if (lobe < 0) return add(Le, direct);
@@ -917,32 +917,31 @@ static int front_emits(const Scene *s, int i, vec ng, vec wo)
 }
 
 /* The BSDF at a hit, for light leaving towards wo. */
-static Bsdf bsdf_at(const Scene *s, const Hit *h, vec wo)
+static void bsdf_at(const Scene *s, const Hit *h, vec wo, Bsdf *b)
 {
     const Material *m = &s->mat[h->mat];
     real sum = m->kd + m->ks + m->kt, k = sum > 1 ? 1 / sum : 1, total;
-    Bsdf b;
     int i;
-    b.n = h->n;
-    b.ng = h->ng;
-    b.eta = 1 / m->ir;
+    b->n = h->n;
+    b->ng = h->ng;
+    b->eta = 1 / m->ir;
     if (dot(wo, h->ng) < 0) {             /* inside: the ray goes out */
-        b.n = scale(-1, b.n);
-        b.ng = scale(-1, b.ng);
-        b.eta = m->ir;
+        b->n = scale(-1, b->n);
+        b->ng = scale(-1, b->ng);
+        b->eta = m->ir;
     }
-    b.albedo = scale(k * m->kd, m->color);
-    b.shine = m->shine;
-    b.glossy = m->shine > 0 ? k * m->ks : 0;
-    b.mirror = m->shine > 0 ? 0 : k * m->ks;
-    b.glass = k * m->kt;
-    b.p[DIFFUSE_LOBE] = fmax(b.albedo.x, fmax(b.albedo.y, b.albedo.z));
-    b.p[GLOSSY_LOBE] = b.glossy;
-    b.p[MIRROR_LOBE] = b.mirror;
-    b.p[GLASS_LOBE] = b.glass;
-    total = b.p[0] + b.p[1] + b.p[2] + b.p[3];
-    for (i = 0; i < 4; i++) b.p[i] = total > 0 ? b.p[i] / total : 0;
-    return b;
+    b->albedo = scale(k * m->kd, m->color);
+    b->shine = m->shine;
+    b->glossy = m->shine > 0 ? k * m->ks : 0;
+    b->mirror = m->shine > 0 ? 0 : k * m->ks;
+    b->glass = k * m->kt;
+    b->p[DIFFUSE_LOBE] = fmax(b->albedo.x, fmax(b->albedo.y, b->albedo.z));
+    b->p[GLOSSY_LOBE] = b->glossy;
+    b->p[MIRROR_LOBE] = b->mirror;
+    b->p[GLASS_LOBE] = b->glass;
+    total = b->p[0] + b->p[1] + b->p[2] + b->p[3];
+    k = total > 0 ? 1 / total : 0;
+    for (i = 0; i < 4; i++) b->p[i] *= k;
 }
 
 /* f(x, wi, wo) for the lobes that are not deltas (Lambert and Phong).  Zero

@@ -105,11 +105,12 @@ done
 slopes=$(awk -F'\t' '$5 >= 0.05 { k = $1 "/" $3; x = log($5); y = log($6);
     n[k]++; sx[k] += x; sy[k] += y; sxx[k] += x * x; sxy[k] += x * y }
   END { for (k in n) if (n[k] > 1) printf "%s %.2f\n", k, (n[k] * sxy[k] - sx[k] * sy[k]) / (n[k] * sxx[k] - sx[k] * sx[k]) }' "$OUT/pt.tsv" | sort)
-{ echo; echo "slope of log RMSE against log time (unbiased noise: -0.5):"; printf '  %s\n' "$slopes"; echo; } | tee -a "$OUT/pt.txt"
+{ echo; echo "slope of log RMSE against log time (unbiased noise: -0.5):"; printf '%s\n' "$slopes" | sed 's/^/  /'; echo; } |
+  tee -a "$OUT/pt.txt"
 
 # The plot: one line per scene and estimator, its slope in its name.
 awk -F'\t' -v slopes="$slopes" 'BEGIN { n = split(slopes, l, "\n"); for (i = 1; i <= n; i++) { split(l[i], p, " "); s[p[1]] = p[2] } }
-  { k = $1 "/" $3; print k "(slope " s[k] ")", $5, $6, $4 }' "$OUT/pt.tsv" |
+  { k = $1 "/" $3; print k ",slope=" s[k], $5, $6, $4 }' "$OUT/pt.tsv" |
   "$OUT/svgplot" --title "make bench: path tracing, time against error (labels: samples per pixel)" \
     --xlabel "CPU seconds, one thread" --ylabel "RMSE (linear) against the $REF_SPP-spp reference" >"$OUT/pt.svg" ||
   die "svgplot failed"

@@ -285,7 +285,7 @@ static Bsdf plane_bsdf(vec albedo, double glossy, double shine, vec wo)
     material(&s, albedo, 1, glossy, 0, 0, 1, shine);
     h.n = h.ng = v3(0, 0, 1);
     h.mat = 0;
-    b = bsdf_at(&s, &h, wo);
+    bsdf_at(&s, &h, wo, &b);
     free_scene(&s);
     return b;
 }
