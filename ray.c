@@ -90,13 +90,20 @@
 #include <errno.h>
 #include <float.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #ifdef RAY_POSIX
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#endif
+#ifdef _WIN32
+#include <fcntl.h>
+#include <io.h>
+#include <process.h>
 #endif
 #include "prims.h"
 #include "kdtree.h"
@@ -1032,7 +1039,10 @@ static int degenerate(vec a, vec b, vec c)
 
 /* ---------------------------------------------------- threads and progress */
 
-typedef struct { int spp, threads, progress; } Options;
+typedef struct {
+    int spp, threads, progress;
+    double start;                 /* when the render began (now()), for the progress line */
+} Options;
 
 /* Seconds on a wall clock (processor time where there is none: with threads
  * that overstates the time). */
@@ -1054,6 +1064,18 @@ static int stderr_is_terminal(void)
 #else
     return 0;
 #endif
+}
+
+/* "ray:  42%  ETA 1:05": rows done out of rows, and the time left if the
+ * rows still to do take as long as those done so far took. */
+static void show_progress(const Options *o, int done, int rows)
+{
+    long left = (long)((now() - o->start) * (rows - done) / done + 0.5);
+    if (left >= 3600)
+        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld:%02ld ", done * 100 / rows, left / 3600,
+                left / 60 % 60, left % 60);
+    else
+        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld    ", done * 100 / rows, left / 60, left % 60);
 }
 
 static void add_counts(Counts *to, const Counts *from)
@@ -1099,12 +1121,12 @@ static void render(const Scene *s, const Options *o, unsigned char *img, Counts 
             OMP(omp atomic capture)
             mine = ++done;
             if (o->progress && (mine * 100 / s->h != (mine - 1) * 100 / s->h))
-                fprintf(stderr, "\rray: %3d%%", mine * 100 / s->h);
+                show_progress(o, mine, s->h);
         }
         OMP(omp critical)
         add_counts(total, &wk.count);
     }
-    if (o->progress) fprintf(stderr, "\r          \r");
+    if (o->progress) fprintf(stderr, "\r%30s\r", "");
 }
 
 /* ------------------------------------------------------------- scene input */
@@ -1509,11 +1531,44 @@ static int load_obj(Scene *s, const char *file, int mat, Where from)
     return ok;
 }
 
+/* Windows paths separate directories with \ as well as /, and may start
+ * with a drive ("C:"); elsewhere \ and : are ordinary characters of a file
+ * name.  -DRAY_DOS_PATHS gives the Windows rule anywhere, for the tests. */
+#if defined(_WIN32) && !defined(RAY_DOS_PATHS)
+#define RAY_DOS_PATHS
+#endif
+
+static int path_separator(int c)
+{
+#ifdef RAY_DOS_PATHS
+    return c == '/' || c == '\\' || c == ':';
+#else
+    return c == '/';
+#endif
+}
+
+/* Where the file's own name starts in path: after the last separator. */
+static const char *file_part(const char *path)
+{
+    const char *p, *name = path;
+    for (p = path; *p; p++)
+        if (path_separator(*p)) name = p + 1;
+    return name;
+}
+
+/* A path from the root (or a drive), which no directory may prefix. */
+static int absolute(const char *path)
+{
+#ifdef RAY_DOS_PATHS
+    if (path[0] && path[1] == ':') return 1;
+#endif
+    return path_separator(path[0]);
+}
+
 /* A path named in a scene is relative to the scene's directory. */
 static char *beside(const char *scene, const char *name)
 {
-    const char *slash = strrchr(scene, '/');
-    size_t dir = name[0] == '/' || !slash ? 0 : (size_t)(slash - scene + 1);
+    size_t dir = absolute(name) ? 0 : (size_t)(file_part(scene) - scene);
     char *p = malloc(dir + strlen(name) + 1);
     if (!p) out_of_memory();
     memcpy(p, scene, dir);
@@ -1990,39 +2045,176 @@ static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain
 
 /* Where the image goes.  It is opened before the render, so that a bad -o
  * fails at once rather than after a long render.  A new or plain file is
- * written as FILE.tmp and renamed over FILE at the end, so that a failure
- * never leaves a half-written image behind.  Anything else (stdout, a device
- * such as /dev/null, a pipe, a symbolic link) is written in place and never
- * renamed over or removed. */
+ * written to a temporary file of this run's own beside it (FILE.tmp.PID),
+ * which is renamed over FILE at the end: a failure or an interrupt never
+ * leaves a half-written image, and keeps the old one.  Anything else
+ * (stdout, a device such as /dev/null, a pipe, a symbolic link) is written
+ * in place and never renamed over or removed. */
 typedef struct { FILE *f; const char *name; char *tmp; int format; } Output;
 
+/* The temporary file's name, for on_signal, which can be handed nothing:
+ * the one global of ray.c (the card has its own).  It is written before the
+ * handler is installed, and the handler only reads it. */
+static char signal_tmp[4096];
+
+/* Ctrl-C (SIGINT), SIGTERM, or a closed terminal (SIGHUP) during a render:
+ * the temporary file is removed, then the signal raised again with its
+ * default action, so that the program ends as that signal ends it (a shell
+ * shows 128 + its number) and the old output stays.  Only calls that are
+ * safe in a signal handler: unlink (remove, where there is no unlink),
+ * signal and raise. */
+static void on_signal(int sig)
+{
 #ifdef RAY_POSIX
-/* Absent, or a plain file (not a link, a device or a pipe)? */
-static int replaceable(const char *name)
+    unlink(signal_tmp);
+#else
+    remove(signal_tmp);
+#endif
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Is sig ignored (as nohup, or a shell for a background job, leaves it)?
+ * Then it stays ignored. */
+static int ignored(int sig)
+{
+#ifdef RAY_POSIX
+    struct sigaction sa;
+    return sigaction(sig, NULL, &sa) == 0 && sa.sa_handler == SIG_IGN;
+#else
+    (void)sig;
+    return 0;
+#endif
+}
+
+/* on_signal for the temporary file tmp, or with tmp NULL the default
+ * action again (the file is renamed into place, or gone).  A name too long
+ * for signal_tmp, which no system takes, is left to the default action. */
+static void catch_signals(const char *tmp)
+{
+#ifdef RAY_POSIX
+    static const int sigs[] = { SIGINT, SIGTERM, SIGHUP };
+#else
+    static const int sigs[] = { SIGINT, SIGTERM };
+#endif
+    size_t i;
+    if (tmp && strlen(tmp) >= sizeof signal_tmp) return;
+    if (tmp) strcpy(signal_tmp, tmp);
+    for (i = 0; i < sizeof sigs / sizeof *sigs; i++)
+        if (!ignored(sigs[i])) signal(sigs[i], tmp ? on_signal : SIG_DFL);
+}
+
+/* Nothing but this run may have opened the file: created here (O_EXCL: not
+ * if it exists, and never through a symbolic link), or NULL with errno
+ * EEXIST.  Without POSIX, the best plain C can do: fail if it can be read. */
+static FILE *create_new(const char *name)
+{
+#ifdef RAY_POSIX
+    int fd = open(name, O_WRONLY | O_CREAT | O_EXCL, 0666);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb");
+    if (fd >= 0 && !f) { close(fd); unlink(name); }
+    return f;
+#else
+    FILE *f = fopen(name, "rb");
+    if (f) { fclose(f); errno = EEXIST; return NULL; }
+    return fopen(name, "wb");
+#endif
+}
+
+/* This process's number, to tell its temporary files from another run's. */
+static long process_id(void)
+{
+#if defined(RAY_POSIX)
+    return (long)getpid();
+#elif defined(_WIN32)
+    return (long)_getpid();
+#else
+    return (long)time(NULL);
+#endif
+}
+
+/* A temporary file beside name that no other run shares: name.tmp.PID, or
+ * name.tmp.PID.K when that exists (left by a run that was killed). */
+static FILE *create_temp(const char *name, char **tmp)
+{
+    int k;
+    FILE *f = NULL;
+    *tmp = malloc(strlen(name) + 48);
+    if (!*tmp) return NULL;
+    for (k = 0; k < 100 && !f; k++) {
+        if (k) sprintf(*tmp, "%s.tmp.%ld.%d", name, process_id(), k);
+        else sprintf(*tmp, "%s.tmp.%ld", name, process_id());
+        f = create_new(*tmp);
+        if (!f && errno != EEXIST) break;
+    }
+    return f;
+}
+
+enum { IN_PLACE, VIA_TEMP, REFUSED };
+
+#ifdef RAY_POSIX
+/* How -o FILE is written: a plain file or a new one through a temporary
+ * (*mode: the old file's permissions, which the new one keeps; -1 for a new
+ * file), anything else in place.  A read-only file is refused, with a
+ * message: replacing it would defeat its protection (root may write any
+ * file, so its mode bits are asked too). */
+static int output_kind(const char *name, int *mode)
 {
     struct stat st;
-    return lstat(name, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode);
+    *mode = -1;
+    if (lstat(name, &st) != 0) return errno == ENOENT ? VIA_TEMP : IN_PLACE;
+    if (!S_ISREG(st.st_mode)) return IN_PLACE;
+    if (access(name, W_OK) != 0 || !(st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH))) {
+        fprintf(stderr, "%s: is read-only; not replaced (make it writable, or write elsewhere)\n",
+                name);
+        return REFUSED;
+    }
+    *mode = (int)(st.st_mode & 07777);
+    return VIA_TEMP;
 }
 #else
-static int replaceable(const char *name) { (void)name; return 1; }
+static int output_kind(const char *name, int *mode)
+{
+    FILE *f = fopen(name, "rb");
+    *mode = -1;
+    if (f) {
+        fclose(f);
+        f = fopen(name, "r+b");     /* opens for writing without changing it */
+        if (!f) {
+            fprintf(stderr, "%s: is read-only; not replaced (make it writable, or write elsewhere)\n",
+                    name);
+            return REFUSED;
+        }
+        fclose(f);
+    }
+    return VIA_TEMP;
+}
 #endif
 
+/* Opens -o name for writing (see Output).  0 after a message. */
 static int open_output(Output *o, const char *name)
 {
+    int mode, kind;
     o->name = name;
     o->tmp = NULL;
     o->f = stdout;
     o->format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
-    if (!strcmp(name, "-")) return 1;
-    if (replaceable(name)) {
-        o->tmp = malloc(strlen(name) + 5);
-        if (!o->tmp) return 0;
-        sprintf(o->tmp, "%s.tmp", name);
-        errno = EEXIST;               /* the message if FILE.tmp is no plain file */
-        o->f = replaceable(o->tmp) ? fopen(o->tmp, "wb") : NULL;
-    } else
-        o->f = fopen(name, "wb");
-    if (o->f) return 1;
+    if (!strcmp(name, "-")) {
+#ifdef _WIN32
+        _setmode(_fileno(stdout), _O_BINARY);    /* P6 and PNG bytes as they are: no \r added */
+#endif
+        return 1;
+    }
+    kind = output_kind(name, &mode);
+    if (kind == REFUSED) return 0;
+    o->f = kind == VIA_TEMP ? create_temp(name, &o->tmp) : fopen(name, "wb");
+#ifdef RAY_POSIX
+    if (o->f && mode >= 0) fchmod(fileno(o->f), (mode_t)mode);
+#endif
+    if (o->f) {
+        if (o->tmp) catch_signals(o->tmp);
+        return 1;
+    }
     fprintf(stderr, "%s: cannot write: %s\n", o->tmp ? o->tmp : name, strerror(errno));
     free(o->tmp);
     return 0;
@@ -2033,7 +2225,19 @@ static void discard_output(Output *o)
 {
     if (o->f != stdout) fclose(o->f);
     if (o->tmp) remove(o->tmp);
+    if (o->tmp) catch_signals(NULL);
     free(o->tmp);
+}
+
+/* rename() over an existing file: POSIX replaces it in one step; Windows
+ * refuses, so there the old file is removed first (for a moment there is
+ * neither: the best plain C can do). */
+static int replace_file(const char *from, const char *to)
+{
+#ifdef _WIN32
+    remove(to);
+#endif
+    return rename(from, to);
 }
 
 /* The image in the output's format, then the file closed and, if it was
@@ -2050,11 +2254,12 @@ static int write_image(Output *o, const unsigned char *img, int w, int h, int pl
         write_ppm(o->f, img, w, h, plain);
     ok = ok && fflush(o->f) == 0 && !ferror(o->f);
     if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
-    if (ok && o->tmp) ok = rename(o->tmp, o->name) == 0;
+    if (ok && o->tmp) ok = replace_file(o->tmp, o->name) == 0;
     if (!ok) {
         fprintf(stderr, "%s: cannot write: %s\n", o->name, strerror(errno));
         if (o->tmp) remove(o->tmp);
     }
+    if (o->tmp) catch_signals(NULL);
     free(o->tmp);
     return ok;
 }
@@ -2078,6 +2283,74 @@ static void usage(FILE *to)
           "             the tree from 8 objects up)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
           "  --help     this text\n", to);
+}
+
+#define RAY_VERSION "1.0"
+
+static void version(void)
+{
+#ifdef _OPENMP
+    const char *threads = "OpenMP threads";
+#else
+    const char *threads = "one thread, no OpenMP";
+#endif
+    printf("ray " RAY_VERSION ", Whitted ray tracer in C99 (%s, %s)\n",
+           sizeof(real) == sizeof(float) ? "float" : "double", threads);
+}
+
+/* The value of option opt ("-n", "--accel") if argv[*i] is that option:
+ * attached ("-n4", "--accel=kd") or the next argument ("-n 4"), which is
+ * then used up.  NULL if argv[*i] is another option; a usage error (exit 2)
+ * if the value is missing. */
+static const char *option_value(int argc, char **argv, int *i, const char *opt)
+{
+    const char *a = argv[*i];
+    size_t n = strlen(opt);
+    if (strncmp(a, opt, n)) return NULL;
+    if (a[n] && opt[1] != '-') return a + n;
+    if (a[n]) return a[n] == '=' ? a + n + 1 : NULL;
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "ray: %s needs a value (see ray --help)\n", opt);
+        exit(2);
+    }
+    return argv[++*i];
+}
+
+/* --accel's value, or a usage error (exit 2) that lists the choices. */
+static const char *accel_arg(const char *v)
+{
+    if (strcmp(v, "kd") && strcmp(v, "none") && strcmp(v, "auto")) {
+        fprintf(stderr, "ray: --accel takes kd (the kd-tree), none (every object) or auto, not %s\n",
+                v);
+        exit(2);
+    }
+    return v;
+}
+
+/* -t asks for threads that a build without OpenMP does not have: said once. */
+static void warn_threads(int threads)
+{
+#ifndef _OPENMP
+    if (threads) fprintf(stderr, "ray: warning: -t %d is ignored: built without OpenMP, one thread\n", threads);
+#else
+    (void)threads;
+#endif
+}
+
+/* Is -o name another file than the scene?  Else a message: the render
+ * would overwrite its own scene.  The same file by device and inode under
+ * POSIX (through links, and however the path is spelled), else by name. */
+static int apart(const char *scene, const char *name)
+{
+#ifdef RAY_POSIX
+    struct stat a, b;
+    int same = stat(scene, &a) == 0 && stat(name, &b) == 0 && a.st_dev == b.st_dev
+               && a.st_ino == b.st_ino;
+#else
+    int same = !strcmp(scene, name);
+#endif
+    if (same) fprintf(stderr, "ray: -o %s is the scene file; not overwritten\n", name);
+    return !same;
 }
 
 /* A whole number from 1 to max, or exit with a message naming the option. */
@@ -2107,10 +2380,8 @@ static int output_usable(const char *name, int plain)
 
 static char *default_output(const char *scene)
 {
-    const char *base = strrchr(scene, '/'), *dot;
+    const char *base = file_part(scene), *dot = strrchr(base, '.');
     char *out;
-    base = base ? base + 1 : scene;
-    dot = strrchr(base, '.');
     out = malloc(strlen(base) + 5);
     if (!out) out_of_memory();
     sprintf(out, "%.*s.ppm", dot ? (int)(dot - base) : (int)strlen(base), base);
@@ -2177,8 +2448,8 @@ static void free_scene(Scene *s)
     free(s->vert); free(s->norm); free(s->light);
 }
 
-/* -s WxH onto the scene; 0 with a message when it is not such a size. */
-static int set_size(Scene *s, const char *size)
+/* -s WxH into *w, *h; 0 with a message when it is not such a size. */
+static int parse_size(const char *size, int *w, int *h)
 {
     char *x, *end = NULL;
     long fw = strtol(size, &x, 10), fh = *x == 'x' ? strtol(x + 1, &end, 10) : 0;
@@ -2186,7 +2457,7 @@ static int set_size(Scene *s, const char *size)
         fprintf(stderr, "ray: -s needs WxH, like 640x480, not %s\n", size);
         return 0;
     }
-    if (!check_size((double)fw, (double)fh, &s->w, &s->h)) {
+    if (!check_size((double)fw, (double)fh, w, h)) {
         fprintf(stderr, "ray: -s %s: " SIZE_RULE "\n", size);
         return 0;
     }
@@ -2196,31 +2467,30 @@ static int set_size(Scene *s, const char *size)
 int main(int argc, char **argv)
 {
     Scene s;
-    Options o = { 1, 0, 0 };
+    Options o = { 1, 0, 0, 0 };
     Counts st;
     Output out;
     const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
     char *auto_name = NULL;
-    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok;
+    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, w = 0, h = 0;
     unsigned char *img;
     double t0, load, build;
 
     for (i = 1; i < argc; i++) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        const char *a = argv[i], *v;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
-        else if (!strcmp(a, "-o") && next) name = argv[++i];
-        else if (!strcmp(a, "-s") && next) size = argv[++i];
-        else if (!strcmp(a, "-n")) { o.spp = int_arg(a, next, 1 << 20); i++; }
-        else if (!strcmp(a, "-d")) { depth = int_arg(a, next, 64); i++; }
-        else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
+        else if (!strcmp(a, "--version")) { version(); return 0; }
+        else if ((v = option_value(argc, argv, &i, "-o"))) name = v;
+        else if ((v = option_value(argc, argv, &i, "-s"))) size = v;
+        else if ((v = option_value(argc, argv, &i, "-n"))) o.spp = int_arg("-n", v, 1 << 20);
+        else if ((v = option_value(argc, argv, &i, "-d"))) depth = int_arg("-d", v, 64);
+        else if ((v = option_value(argc, argv, &i, "-t"))) o.threads = int_arg("-t", v, 4096);
+        else if ((v = option_value(argc, argv, &i, "--accel"))) accel = accel_arg(v);
         else if (!strcmp(a, "--p3")) plain = 1;
         else if (!strcmp(a, "--gamma")) gamma = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
-        else if (!strcmp(a, "--accel") && next
-                 && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
-            accel = argv[++i];
         else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "ray: unknown option, or a bad or missing value: %s\n", a);
+            fprintf(stderr, "ray: unknown option: %s\n", a);
             usage(stderr);
             return 2;
         } else if (scene) {
@@ -2230,9 +2500,16 @@ int main(int argc, char **argv)
         else scene = a;
     }
     if (!scene) { usage(stderr); return 2; }
-    if (name && !output_usable(name, plain)) return 2;
+    if (!name) name = auto_name = default_output(scene);
+    if ((size && !parse_size(size, &w, &h)) || !output_usable(name, plain)
+        || !apart(scene, name)) {
+        free(auto_name);
+        return 2;
+    }
+    warn_threads(o.threads);
     load = now();
-    ok = load_scene(&s, scene) && (!size || set_size(&s, size));
+    ok = load_scene(&s, scene);
+    if (ok && size) { s.w = w; s.h = h; }
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
     if (depth) s.depth = depth;
@@ -2240,7 +2517,6 @@ int main(int argc, char **argv)
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
-    if (ok && !name) name = auto_name = default_output(scene);
     if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
 
     img = malloc((size_t)s.w * s.h * 3);
@@ -2252,7 +2528,7 @@ int main(int argc, char **argv)
     }
     o.progress = stderr_is_terminal();
     memset(&st, 0, sizeof st);
-    t0 = now();
+    t0 = o.start = now();
     render(&s, &o, img, &st);
     t0 = now() - t0;
     ok = write_image(&out, img, s.w, s.h, plain, gamma);

@@ -42,3 +42,137 @@ print(' ' + ' '.join(str(min(255, max(0, round(255 * f(v))))) for f in (lambda v
 " | tr -d '\n' > "$TMP/want"
 cmp -s "$TMP/got" "$TMP/want" && ok "--gamma gives the sRGB curve's bytes, linear without it ($(cat "$TMP/want"))" \
   || bad "--gamma bytes: got$(cat "$TMP/got"), want$(cat "$TMP/want")"
+
+# --- Unit tests of the plumbing (tests/test_io.c): the curve at worked
+# points, CRC-32 and Adler-32 check values, extensions, and paths split as
+# POSIX and (-DRAY_DOS_PATHS) as Windows splits them.
+for paths in "" -DRAY_DOS_PATHS; do
+  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c kdtree.c -lm 2> "$TMP/err"; then
+    "$TMP/test_io"
+  else
+    bad "tests/test_io.c $paths compiles: $(head -3 "$TMP/err")"
+  fi
+done
+
+# --- Output that is neither lost nor left behind (issue 13, section 3).
+# big: a render that takes minutes, to be interrupted once its temporary file
+# (FILE.tmp.PID) is there.
+big="-s 3000x3000 -n 16 scenes/whitted.sph"
+wait_for_temp() {  # wait_for_temp PATTERN COUNT: up to 10 s for COUNT files
+  local k
+  for k in $(seq 100); do
+    [ "$(ls $1 2>/dev/null | wc -l)" -ge "$2" ] && return 0
+    sleep 0.1
+  done
+  return 1
+}
+mkdir "$TMP/out"
+set -m   # job control: a background job would otherwise ignore SIGINT
+for sig in INT TERM; do
+  echo "old image" > "$TMP/out/x.ppm"
+  ./ray $big -o "$TMP/out/x.ppm" 2>/dev/null & pid=$!
+  wait_for_temp "$TMP/out/x.ppm.tmp.*" 1; kill -$sig $pid; wait $pid; rc=$?
+  want=$((128 + $(kill -l $sig)))
+  [ $rc = $want ] && [ "$(ls "$TMP/out")" = x.ppm ] && [ "$(cat "$TMP/out/x.ppm")" = "old image" ] \
+    && ok "SIG$sig during a render: exit $rc, the temporary file removed, the old image kept" \
+    || bad "SIG$sig: exit $rc (want $want), left: $(ls "$TMP/out" | tr '\n' ' ')"
+done
+set +m
+
+# Two runs at once with the same -o: each has a temporary file of its own.
+./ray $big -o "$TMP/out/x.ppm" 2>/dev/null & p1=$!
+./ray $big -o "$TMP/out/x.ppm" 2>/dev/null & p2=$!
+wait_for_temp "$TMP/out/x.ppm.tmp.*" 2 && n=2 || n=$(ls "$TMP/out" | grep -c tmp)
+kill -TERM $p1 $p2; wait $p1 $p2 2>/dev/null
+[ $n = 2 ] && [ "$(ls "$TMP/out")" = x.ppm ] && ok "two runs with the same -o write two temporary files, and leave none" \
+  || bad "two runs with the same -o: $n temporary files, left: $(ls "$TMP/out" | tr '\n' ' ')"
+# A name this run would take for its temporary file, already there as a
+# link, is neither followed nor replaced: the shell's PID is the one ray gets
+# by exec.
+echo victim > "$TMP/victim"
+sh -c 'ln -s "$1/victim" "$1/out/x.ppm.tmp.$$"; exec ./ray -s 8x8 -o "$1/out/x.ppm" scenes/minray.sph' sh "$TMP"; rc=$?
+[ $rc = 0 ] && [ "$(cat "$TMP/victim")" = victim ] && [ "$(head -c 2 "$TMP/out/x.ppm")" = P6 ] \
+  && [ "$(ls "$TMP/out" | wc -l)" = 2 ] && ok "a temporary name already taken (a link) is not followed; another is used" \
+  || bad "taken temporary name: exit $rc, victim: $(cat "$TMP/victim"), left: $(ls "$TMP/out" | tr '\n' ' ')"
+rm -f "$TMP/out/"*
+
+# A read-only output is refused (exit 1, a message, untouched); a writable
+# one keeps its mode through the rename.
+echo "read-only image" > "$TMP/out/ro.ppm"; chmod 444 "$TMP/out/ro.ppm"
+./ray -s 8x8 -o "$TMP/out/ro.ppm" scenes/minray.sph 2> "$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "ro.ppm: is read-only; not replaced" "$TMP/err" && [ "$(cat "$TMP/out/ro.ppm")" = "read-only image" ] \
+  && [ "$(ls "$TMP/out")" = ro.ppm ] && ok "a read-only -o is refused: $(sed "s|$TMP/out/||" "$TMP/err")" \
+  || bad "read-only -o: exit $rc, $(cat "$TMP/err")"
+echo old > "$TMP/out/m.ppm"; chmod 640 "$TMP/out/m.ppm"
+./ray -s 8x8 -o "$TMP/out/m.ppm" scenes/minray.sph && [ "$(stat -c %a "$TMP/out/m.ppm")" = 640 ] \
+  && [ "$(head -c 2 "$TMP/out/m.ppm")" = P6 ] && ok "a replaced -o keeps its mode (640)" \
+  || bad "mode after replacing: $(stat -c %a "$TMP/out/m.ppm")"
+
+# -o naming the scene itself, however spelled, is refused (exit 2) and the
+# scene is left as it was.
+cp scenes/minray.sph "$TMP/out/s.sph"; ln -s s.sph "$TMP/out/link.sph"; ln "$TMP/out/s.sph" "$TMP/out/hard.sph"
+for o in "$TMP/out/s.sph" "$TMP/out/../out/s.sph" "$TMP/out/link.sph" "$TMP/out/hard.sph"; do
+  ./ray -s 8x8 -o "$o" "$TMP/out/s.sph" 2> "$TMP/err"; rc=$?
+  [ $rc = 2 ] && cmp -s scenes/minray.sph "$TMP/out/s.sph" && grep -q "is the scene file" "$TMP/err" \
+    && ok "-o ${o#$TMP/out/} is the scene: refused, exit 2" || bad "-o ${o#$TMP/out/} as the scene: exit $rc, $(cat "$TMP/err")"
+done
+
+# --- The command line (issue 13, section 4): values attached to their
+# option, the choices of --accel, exit 2 for every usage error and 1 for a
+# bad scene, --version, -t without OpenMP, and the progress line's ETA.
+./ray -s 16x8 -n 3 -d 2 -t 1 --accel kd -o "$TMP/spaced.ppm" scenes/whitted.sph \
+  && ./ray -s16x8 -n3 -d2 -t1 --accel=kd -o"$TMP/attached.ppm" scenes/whitted.sph \
+  && cmp -s "$TMP/spaced.ppm" "$TMP/attached.ppm" && ok "-s16x8 -n3 -d2 -t1 --accel=kd -oFILE: as with spaces" \
+  || bad "attached option values"
+./ray --accel bvh scenes/minray.sph 2> "$TMP/err"; rc=$?
+[ $rc = 2 ] && grep -q "kd.*none.*auto.*not bvh" "$TMP/err" && ok "--accel bvh: exit 2, $(cat "$TMP/err")" \
+  || bad "--accel bvh: exit $rc, $(cat "$TMP/err")"
+printf '%s\n' '0 6 .5  1 1 1  .9 .05 .2 .85 0 1.7' > "$TMP/s.sph"
+for args in "--bogus" "-n 0" "-n x" "-n" "-s 0x10" "-s axb" "-s" "-d 65" "-t 0" "--accel" "--accel=" \
+            "--accelx" "-o $TMP/x.gif" "$TMP/s.sph"; do
+  ./ray -o "$TMP/u.ppm" $args "$TMP/s.sph" > /dev/null 2> "$TMP/err"; rc=$?
+  [ $rc = 2 ] && [ -s "$TMP/err" ] && [ ! -e "$TMP/u.ppm" ] || { bad "usage error ${args//$TMP\//}: exit $rc"; continue; }
+  ok "usage error ${args//$TMP\//}: exit 2, $(head -1 "$TMP/err" | sed "s|$TMP/||g")"
+done
+./ray > /dev/null 2>&1; [ $? = 2 ] && ok "no scene: exit 2" || bad "no scene: exit $?"
+printf 'sphre 1\n' > "$TMP/bad.sph"
+for scene in "$TMP/bad.sph" "$TMP/none.sph"; do
+  ./ray -o "$TMP/u.ppm" "$scene" 2> /dev/null; rc=$?
+  [ $rc = 1 ] && ok "bad input file ${scene#$TMP/}: exit 1" || bad "bad input file ${scene#$TMP/}: exit $rc"
+done
+./ray --version > "$TMP/out.txt"; rc=$?
+[ $rc = 0 ] && grep -qE "^ray [0-9]+\.[0-9]+" "$TMP/out.txt" && ok "--version: $(cat "$TMP/out.txt")" \
+  || bad "--version: exit $rc, $(cat "$TMP/out.txt")"
+# -t without OpenMP: one warning however often -t is given; with it, none.
+if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c kdtree.c -lm 2> "$TMP/err"; then
+  "$TMP/ray_serial" -t 2 -t 3 -s 4x4 -o "$TMP/t.ppm" scenes/minray.sph 2> "$TMP/err"
+  [ "$(grep -c "warning: -t 3 is ignored" "$TMP/err")" = 1 ] && [ "$(wc -l < "$TMP/err")" = 1 ] \
+    && ok "-t without OpenMP warns once: $(cat "$TMP/err")" || bad "-t without OpenMP: $(cat "$TMP/err")"
+else
+  bad "ray.c builds without OpenMP: $(head -3 "$TMP/err")"
+fi
+./ray -t 2 -s 4x4 -o "$TMP/t.ppm" scenes/minray.sph 2> "$TMP/err"
+if ./ray --version | grep -q OpenMP; then
+  [ ! -s "$TMP/err" ] && ok "-t with OpenMP: no warning" || bad "-t with OpenMP warned: $(cat "$TMP/err")"
+fi
+# The progress line (only when stderr is a terminal: a pseudo-terminal here).
+python3 -c '
+import os, pty, subprocess, sys
+master, slave = pty.openpty()
+p = subprocess.Popen(sys.argv[1:], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=slave)
+os.close(slave)
+out = b""
+while True:
+    try:
+        data = os.read(master, 4096)
+    except OSError:
+        break
+    if not data:
+        break
+    out += data
+p.wait()
+sys.stdout.write(out.decode("ascii", "replace").replace("\r", "\n"))
+' ./ray -s 200x200 -n 2 -o "$TMP/p.ppm" scenes/whitted.sph > "$TMP/tty" 2>&1
+grep -qE "^ray: +[0-9]+%  ETA [0-9]+:[0-9][0-9]" "$TMP/tty" \
+  && ok "the progress line shows an ETA: $(grep ETA "$TMP/tty" | head -1)" \
+  || bad "progress line: $(head -3 "$TMP/tty" | tr -cd '[:print:]\n' | tr '\n' '|')"
