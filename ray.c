@@ -1133,9 +1133,25 @@ static void render(const Scene *s, const Options *o, unsigned char *img, Counts 
 
 typedef struct { const char *file; int line; } Where;
 
+/* s on f, with every byte that is not printable ASCII as \xNN: a message
+ * that quotes a file never sends a terminal raw binary. */
+static void put_escaped(FILE *f, const char *s)
+{
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c >= 0x20 && c < 0x7F) putc(c, f);
+        else fprintf(f, "\\x%02X", c);
+    }
+}
+
 static int fail(Where w, const char *msg, const char *arg)
 {
-    fprintf(stderr, "%s:%d: %s%s%s\n", w.file, w.line, msg, arg ? ": " : "", arg ? arg : "");
+    fprintf(stderr, "%s:%d: %s", w.file, w.line, msg);
+    if (arg) {
+        fputs(": ", stderr);
+        put_escaped(stderr, arg);
+    }
+    fputc('\n', stderr);
     return 0;
 }
 
@@ -1394,17 +1410,70 @@ static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
     return 1;
 }
 
+/* The largest |coordinate| of a light or the camera: two points within it
+ * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
+ * takes between them (to a light, from the eye) stay finite.  Beyond it, a
+ * light or a view goes black without a word.  3.9e153 in doubles. */
+#define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
+
+static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
+
+/* a times the power of two that brings its largest coordinate into
+ * [1/2, 1): the same direction, and exactly the same unit() and cross()
+ * bits as a itself, yet no square of it overflows or underflows. */
+static vec pow2_scaled(vec a)
+{
+    int e;
+    real m = maxabs(a);
+    if (!(m > 0) || !isfinite(m)) return a;
+    frexp(m, &e);
+    return v3((real)ldexp(a.x, -e), (real)ldexp(a.y, -e), (real)ldexp(a.z, -e));
+}
+
+/* The narrowest field of view, in degrees, for which the image plane of
+ * camera_ray stays near enough to square its distance at 32768 pixels
+ * across: 2.8e-148 degrees in doubles. */
+static double narrowest_fov(void)
+{
+    return 2 * atan(16384 / (sqrt(sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 2))
+           * 180 / PI;
+}
+
+/* A point light, within FAR_LIMIT. */
+static int point_light(Scene *s, Where w, vec pos, vec color)
+{
+    char msg[128];
+    if (!within_far_limit(pos)) {
+        sprintf(msg, "light too far out: beyond %.2g, its squared distance to the scene overflows",
+                (double)FAR_LIMIT);
+        return fail(w, msg, NULL);
+    }
+    add_light(s, pos, color, -1);
+    return 1;
+}
+
 static int set_camera(Scene *s, Where w, const real *v)
 {
     Camera *c = &s->cam;
-    vec at = v3(v[3], v[4], v[5]), up = v3(v[6], v[7], v[8]);
+    vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
+    char msg[160];
     c->eye = v3(v[0], v[1], v[2]);
-    if (!(dot(sub(at, c->eye), sub(at, c->eye)) > 0))
+    if (!within_far_limit(c->eye) || !within_far_limit(at)) {
+        sprintf(msg, "camera too far out: beyond %.2g, squared distances from the eye overflow",
+                (double)FAR_LIMIT);
+        return fail(w, msg, NULL);
+    }
+    if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
         return fail(w, "camera looks at its own eye", NULL);
     if (!(v[9] > 0 && v[9] < 180))
         return fail(w, "field of view must be between 0 and 180 degrees", NULL);
+    if (!(v[9] >= narrowest_fov())) {
+        sprintf(msg, "field of view too narrow: under %.2g degrees the image plane is so far away"
+                " that its squared distance overflows", narrowest_fov());
+        return fail(w, msg, NULL);
+    }
     c->tan_half = tan(v[9] * PI / 360);
-    c->fwd = unit(sub(at, c->eye));
+    c->fwd = unit(pow2_scaled(sub(at, c->eye)));
     c->right = cross(c->fwd, up);
     if (!(dot(c->right, c->right) > 0)) return fail(w, "camera up is parallel to its view", NULL);
     c->right = unit(c->right);
@@ -1445,17 +1514,29 @@ static int tokens(char *line, char **tok, int max)
     }
 }
 
-/* Reads the next line of f into line; 0 at the end or on an over-long line
- * (then *ok is cleared and the message printed). */
+#define BOM "\xEF\xBB\xBF"          /* UTF-8's byte order mark, which some editors write */
+
+/* Reads the next line of f into line, without its end: "\n", "\r\n" or a
+ * lone "\r" (old Mac files) each end a line.  A byte order mark before the
+ * first line is skipped.  0 at the end of the file, or after a message
+ * (*ok cleared) on an over-long line or a NUL byte, which no text has. */
 static int next_line(FILE *f, char *line, int size, Where *w, int *ok)
 {
-    if (!fgets(line, size, f)) return 0;
+    int c = getc(f), n = 0;
+    if (c == EOF) return 0;
     w->line++;
-    if (!strchr(line, '\n') && !feof(f)) {
-        char msg[64];
-        sprintf(msg, "line longer than %d characters", size - 2);
-        return *ok = fail(*w, msg, NULL);
+    for (; c != EOF && c != '\n' && c != '\r'; c = getc(f)) {
+        if (c == 0) return *ok = fail(*w, "NUL byte: this is not a text file", NULL);
+        if (n == size - 1) {
+            char msg[64];
+            sprintf(msg, "line longer than %d characters", size - 1);
+            return *ok = fail(*w, msg, NULL);
+        }
+        line[n++] = (char)c;
     }
+    if (c == '\r' && (c = getc(f)) != '\n' && c != EOF) ungetc(c, f);
+    line[n] = 0;
+    if (w->line == 1 && !strncmp(line, BOM, 3)) memmove(line, line + 3, (size_t)n - 2);
     return 1;
 }
 
@@ -1522,11 +1603,14 @@ static int load_obj(Scene *s, const char *file, int mat, Where from)
             sprintf(first_skipped, "%.20s", tok[0]);
         }
     }
+    if (ok && ferror(f)) ok = fail(w, "cannot read mesh", strerror(errno)); /* mesh . */
     if (f) fclose(f);
-    if (ok && skipped)
+    if (ok && skipped) {
         fprintf(stderr, "%s:%d: warning: skipped %d statement%s that are not v, vn or f"
-                " (the first: %s)\n",
-                file, skipped_line, skipped, skipped == 1 ? "" : "s", first_skipped);
+                " (the first: ", file, skipped_line, skipped, skipped == 1 ? "" : "s");
+        put_escaped(stderr, first_skipped);
+        fputs(")\n", stderr);
+    }
     free(line); free(tok); free(vi); free(ni);
     return ok;
 }
@@ -1604,11 +1688,9 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
     }
     if (!strcmp(k, "camera"))
         return numbers(w, k, tok, ntok, 1, 10, v) && set_camera(s, w, v);
-    if (!strcmp(k, "light")) {
-        if (!numbers(w, k, tok, ntok, 1, 6, v)) return 0;
-        add_light(s, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]), -1);
-        return 1;
-    }
+    if (!strcmp(k, "light"))
+        return numbers(w, k, tok, ntok, 1, 6, v)
+               && point_light(s, w, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]));
     if (!strcmp(k, "pixel")) {
         if (ntok != 2
             || (strcmp(tok[1], "corner") && strcmp(tok[1], "centre") && strcmp(tok[1], "center")))
@@ -1678,7 +1760,16 @@ static int load_sph(Scene *s, FILE *f, Where w)
 /* NFF is a stream of blank-separated tokens, not of lines (a cone's eight
  * numbers may sit on one line or three), so it is read a token at a time.
  * `again` hands the last token out once more, for a look ahead. */
-typedef struct { FILE *f; Where w; int c, again; char tok[256]; } Lexer;
+typedef struct { FILE *f; Where w; int c, prev, again; char tok[256]; } Lexer;
+
+/* On to the next character, counting lines: "\n", "\r\n" and a lone
+ * "\r" each end one. */
+static void advance(Lexer *lx)
+{
+    if (lx->c == '\r' || (lx->c == '\n' && lx->prev != '\r')) lx->w.line++;
+    lx->prev = lx->c;
+    lx->c = getc(lx->f);
+}
 
 /* The next token into lx->tok: 1, or 0 at the end of the file, or -1 after
  * saying what is wrong. */
@@ -1687,12 +1778,15 @@ static int next_token(Lexer *lx)
     int n = 0;
     if (lx->again) { lx->again = 0; return 1; }
     for (;;) {
-        for (; blank(lx->c); lx->c = getc(lx->f))
-            if (lx->c == '\n') lx->w.line++;
+        while (blank(lx->c)) advance(lx);
         if (lx->c != '#') break;
-        while (lx->c != '\n' && lx->c != EOF) lx->c = getc(lx->f);
+        while (lx->c != '\n' && lx->c != '\r' && lx->c != EOF && lx->c != 0) advance(lx);
     }
-    for (; lx->c != EOF && !blank(lx->c); lx->c = getc(lx->f)) {
+    for (; lx->c != EOF && !blank(lx->c); advance(lx)) {
+        if (lx->c == 0) {
+            fail(lx->w, "NUL byte: this is not a text file", NULL);
+            return -1;
+        }
         if (n == (int)sizeof lx->tok - 1) {
             fail(lx->w, "token longer than 255 characters", NULL);
             return -1;
@@ -1772,13 +1866,14 @@ static int nff_light(Scene *s, Lexer *lx)
 {
     real x[3], rgb[3] = { 1, 1, 1 };
     int got;
+    Where at;
     if (!nff_numbers(lx, "l", 3, x)) return 0;
+    at = lx->w;                              /* before the look ahead */
     got = next_token(lx);                    /* a colour, or the next entity */
     if (got < 0) return 0;
     lx->again = got > 0;
     if (got > 0 && strchr("+-.0123456789", lx->tok[0]) && !nff_numbers(lx, "l", 3, rgb)) return 0;
-    add_light(s, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]), -1);
-    return 1;
+    return point_light(s, at, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]));
 }
 
 /* b r g b: the colour of rays that hit nothing. */
@@ -1807,8 +1902,12 @@ static int nff_sphere(Scene *s, Lexer *lx, int mat)
 {
     real x[4];
     if (!nff_numbers(lx, "s", 4, x)) return 0;
-    if (!(x[3] > 0)) return fail(lx->w, "sphere radius must be positive", lx->tok);
-    add_sphere(s, v3(x[0], x[1], x[2]), x[3], mat);
+    /* NFF.TXT: "If the radius is negative, then only the sphere's inside
+     * is visible (objects are normally considered one sided, with the
+     * outside visible)."  ray.c draws both sides of a sphere, so the inside
+     * is seen from within either way: the radius is |r|. */
+    if (!(x[3] != 0)) return fail(lx->w, "sphere radius must not be 0", lx->tok);
+    add_sphere(s, v3(x[0], x[1], x[2]), fabs(x[3]), mat);
     return 1;
 }
 
@@ -1816,7 +1915,23 @@ static int nff_sphere(Scene *s, Lexer *lx, int mat)
 static int nff_cone(Scene *s, Lexer *lx, int mat)
 {
     real x[8];
-    return nff_numbers(lx, "c", 8, x) && check_cone(s, lx->w, x, mat);
+    if (!nff_numbers(lx, "c", 8, x)) return 0;
+    if (x[3] < 0 && x[7] < 0) {   /* NFF.TXT: both negative, only the inside visible; as spheres */
+        x[3] = -x[3];
+        x[7] = -x[7];
+    }
+    return check_cone(s, lx->w, x, mat);
+}
+
+/* The rest of a byte order mark, whose first byte is lx->c. */
+static int skip_bom(Lexer *lx)
+{
+    int b1 = getc(lx->f), b2 = getc(lx->f);
+    if (b1 != (unsigned char)BOM[1] || b2 != (unsigned char)BOM[2])
+        return fail(lx->w, "not an NFF file: it starts with byte 0xEF, yet no UTF-8 byte order mark",
+                    NULL);
+    lx->c = getc(lx->f);
+    return 1;
 }
 
 static int load_nff(Scene *s, FILE *f, Where w)
@@ -1824,7 +1939,8 @@ static int load_nff(Scene *s, FILE *f, Where w)
     Lexer lx;
     int mat = -1, k, ok = 1, got = 1;
     double intensity;
-    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.again = 0;
+    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.prev = 0; lx.again = 0;
+    if (lx.c == (unsigned char)BOM[0] && !skip_bom(&lx)) return 0;
     while (ok && (got = next_token(&lx)) > 0) {
         const char *t = lx.tok;
         if (mat < 0 && strchr("spc", t[0])) {    /* objects before any f: plain white */
@@ -1851,16 +1967,26 @@ static int load_nff(Scene *s, FILE *f, Where w)
     return ok;
 }
 
-/* The scene by its name: NFF when it ends .nff, else the sphere format. */
+/* Does name end with ext (given in lower case), in any case? */
+static int has_extension(const char *name, const char *ext)
+{
+    size_t n = strlen(name), k = strlen(ext), i;
+    if (n < k) return 0;
+    for (i = 0; i < k; i++)
+        if (tolower((unsigned char)name[n - k + i]) != ext[i]) return 0;
+    return 1;
+}
+
+/* The scene by its name: NFF when it ends .nff (or .NFF), else the sphere
+ * format. */
 static int load_scene(Scene *s, const char *file)
 {
     Where w = { file, 0 };
     FILE *f = fopen(file, "r");
-    size_t len = strlen(file);
     int ok;
     default_scene(s);
     if (!f) return fail(w, "cannot open scene", strerror(errno));
-    ok = len > 4 && !strcmp(file + len - 4, ".nff") ? load_nff(s, f, w) : load_sph(s, f, w);
+    ok = has_extension(file, ".nff") ? load_nff(s, f, w) : load_sph(s, f, w);
     if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
     fclose(f);
     return ok;
@@ -1876,16 +2002,6 @@ static real srgb_encode(real linear)
 {
     if (!(linear > 0.0031308)) return (real)(12.92 * linear);
     return (real)(1.055 * pow(linear, 1 / 2.4) - 0.055);
-}
-
-/* Does name end with ext (given in lower case), in any case? */
-static int has_extension(const char *name, const char *ext)
-{
-    size_t n = strlen(name), k = strlen(ext), i;
-    if (n < k) return 0;
-    for (i = 0; i < k; i++)
-        if (tolower((unsigned char)name[n - k + i]) != ext[i]) return 0;
-    return 1;
 }
 
 enum { FORMAT_PPM, FORMAT_PNG, FORMAT_OTHER };

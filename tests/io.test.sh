@@ -176,3 +176,90 @@ sys.stdout.write(out.decode("ascii", "replace").replace("\r", "\n"))
 grep -qE "^ray: +[0-9]+%  ETA [0-9]+:[0-9][0-9]" "$TMP/tty" \
   && ok "the progress line shows an ETA: $(grep ETA "$TMP/tty" | head -1)" \
   || bad "progress line: $(head -3 "$TMP/tty" | tr -cd '[:print:]\n' | tr '\n' '|')"
+
+# --- Readers that say what is really wrong (issue 13, section 4).
+# same_image NAME SCENE REFERENCE-SCENE: both render to the same bytes.
+same_image() {
+  ./ray -s 24x16 -o "$TMP/a.ppm" "$2" 2> "$TMP/err" && ./ray -s 24x16 -o "$TMP/b.ppm" "$3" 2>> "$TMP/err" \
+    && cmp -s "$TMP/a.ppm" "$TMP/b.ppm" && ok "$1" || bad "$1: $(head -2 "$TMP/err" | sed "s|$TMP/||g")"
+}
+# refused NAME SCENE PATTERN: exit 1, PATTERN in the message, no image.
+refused() {
+  rm -f "$TMP/r.ppm"
+  ./ray -o "$TMP/r.ppm" "$2" 2> "$TMP/err"; rc=$?
+  [ $rc = 1 ] && grep -qE "$3" "$TMP/err" && [ ! -e "$TMP/r.ppm" ] && ok "$1: $(head -1 "$TMP/err" | sed "s|$TMP/||g")" \
+    || bad "$1: exit $rc, $(head -1 "$TMP/err" | sed "s|$TMP/||g")"
+}
+mkdir "$TMP/in"; cp scenes/mesh.sph scenes/ball.obj scenes/demo.nff "$TMP/in/"
+{ printf '\357\273\277'; cat scenes/whitted.sph; } > "$TMP/in/bom.sph"
+same_image "a UTF-8 byte order mark before a sphere file is skipped" "$TMP/in/bom.sph" scenes/whitted.sph
+{ printf '\357\273\277'; cat scenes/demo.nff; } > "$TMP/in/bom.nff"
+same_image "a byte order mark before an NFF file is skipped" "$TMP/in/bom.nff" scenes/demo.nff
+{ printf '\357\273\277'; grep -v '^#' scenes/ball.obj; } > "$TMP/in/ball.obj"   # a v first
+same_image "a byte order mark before an OBJ file is skipped" "$TMP/in/mesh.sph" scenes/mesh.sph
+cp scenes/demo.nff "$TMP/in/DEMO.NFF"
+same_image "DEMO.NFF (upper case) is read as NFF" "$TMP/in/DEMO.NFF" scenes/demo.nff
+tr '\n' '\r' < scenes/whitted.sph > "$TMP/in/cr.sph"
+same_image "CR line ends (old Mac) in a sphere file" "$TMP/in/cr.sph" scenes/whitted.sph
+tr '\n' '\r' < scenes/demo.nff > "$TMP/in/cr.nff"
+same_image "CR line ends in an NFF file" "$TMP/in/cr.nff" scenes/demo.nff
+tr '\n' '\r' < scenes/ball.obj > "$TMP/in/ball.obj"
+same_image "CR line ends in an OBJ file" "$TMP/in/mesh.sph" scenes/mesh.sph
+sed 's/$/\r/' scenes/demo.nff > "$TMP/in/crlf.nff"
+same_image "CRLF line ends in an NFF file" "$TMP/in/crlf.nff" scenes/demo.nff
+printf '# one\r# two\rsphre 1 2 3\r' > "$TMP/in/crline.sph"
+refused "an error after CR line ends is on its line" "$TMP/in/crline.sph" "crline.sph:3: unknown keyword: sphre"
+printf '# one\r\r\n# three\rq 1\n' > "$TMP/in/crline.nff"
+refused "NFF lines count CR, CRLF and LF once each" "$TMP/in/crline.nff" "crline.nff:4: unknown NFF entity: q"
+printf 'size 8 8\n0 6 .5 1 1 1 .9 .05 .2 .85 0 1.7\0\n' > "$TMP/in/nul.sph"
+refused "a NUL byte in a sphere file" "$TMP/in/nul.sph" "nul.sph:2: NUL byte"
+printf 'b 0 0 0\nl 1\0 2 3\n' > "$TMP/in/nul.nff"
+refused "a NUL byte in an NFF number" "$TMP/in/nul.nff" "nul.nff:2: NUL byte"
+printf '# a\0\n' > "$TMP/in/nulc.nff"
+refused "a NUL byte in an NFF comment" "$TMP/in/nulc.nff" "nulc.nff:1: NUL byte"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1\0 0\n' > "$TMP/in/nul.obj"
+printf 'mesh nul.obj 1 1 1 1 0 0 0 1\n' > "$TMP/in/nulobj.sph"
+refused "a NUL byte in an OBJ file" "$TMP/in/nulobj.sph" "nul.obj:3: NUL byte"
+printf 'mesh . 1 1 1 1 0 0 0 1\n' > "$TMP/in/dir.sph"
+refused "mesh . (a directory)" "$TMP/in/dir.sph" "/in/\.:0: cannot read mesh: Is a directory"
+refused "a directory as the scene" "$TMP/in" "in:0: read error: Is a directory"
+printf 'size 8 8\n\001\377\033[31m 1 2 3\n' > "$TMP/in/bin.sph"
+refused "raw bytes in a message are escaped" "$TMP/in/bin.sph" 'bin.sph:2: unknown keyword: \\x01\\xFF\\x1B\[31m'
+LC_ALL=C grep -q '[^[:print:]]' "$TMP/err" && bad "the message above has raw bytes" || ok "the message has no raw byte"
+printf 'b 0 0 0\n\351t\351 1\n' > "$TMP/in/bin.nff"
+refused "raw bytes in an NFF message are escaped" "$TMP/in/bin.nff" 'bin.nff:2: unknown NFF entity: \\xE9t\\xE9'
+sed 's/^s -1.5 0 1 1$/s -1.5 0 1 -1/; s/^c 1.5 0.5 0 0.8 1.5 0.5 2 0.2$/c 1.5 0.5 0 -0.8 1.5 0.5 2 -0.2/' \
+  scenes/demo.nff > "$TMP/in/neg.nff"
+grep -q "^s .* -1$" "$TMP/in/neg.nff" && grep -q "^c .* -0.2$" "$TMP/in/neg.nff" \
+  && same_image "NFF's negative radii (inside visible) are read as |r|: a sphere, a cone" "$TMP/in/neg.nff" scenes/demo.nff \
+  || bad "neg.nff was not made"
+
+# The range of the maths: a light or an eye so far out that squared
+# distances overflow, a field of view so narrow that the image plane's does;
+# up vectors and views of any length otherwise work.
+ball='0 0 0  1 1 1  1  1 0 0 0 1
+light 0 -10 3  1 1 1
+background .2 .3 .4'
+printf 'camera 0 -5 0 0 0 0 0 0 1 40\nlight 0 -1e154 0 1 1 1\n%s\n' "$ball" > "$TMP/in/far.sph"
+refused "a light at 1e154" "$TMP/in/far.sph" "far.sph:2: light too far out: beyond 3.9e\+153, its squared distance to the scene overflows"
+for at in 3.8e153 1000; do
+  printf 'camera 0 -5 0 0 0 0 0 0 1 40\nlight 0 -%s 0 1 1 1\n0 0 0 1 1 1 1 1 0 0 0 1\n' $at > "$TMP/in/light$at.sph"
+done
+./ray -s 24x16 -o "$TMP/a.ppm" "$TMP/in/light3.8e153.sph" && ./ray -s 24x16 -o "$TMP/b.ppm" "$TMP/in/light1000.sph" \
+  && tools/ppmdiff -t 1 "$TMP/a.ppm" "$TMP/b.ppm" > "$TMP/diff" 2>&1 \
+  && ok "a light at 3.8e153 lights the ball as one at 1000 does (within a level: parallax)" \
+  || bad "a light at 3.8e153: $(cat "$TMP/diff")"
+printf 'b 0 0 0\nl 0 0 5e153\n' > "$TMP/in/far.nff"
+refused "an NFF light at 5e153" "$TMP/in/far.nff" "far.nff:2: light too far out"
+printf 'camera 0 -1e308 0 0 0 0 0 0 1 40\n%s\n' "$ball" > "$TMP/in/eye.sph"
+refused "an eye at 1e308" "$TMP/in/eye.sph" "eye.sph:1: camera too far out: beyond 3.9e\+153"
+printf 'camera 0 -5 0 0 0 0 0 0 1 1e-152\n%s\n' "$ball" > "$TMP/in/fov.sph"
+refused "a field of view of 1e-152 degrees" "$TMP/in/fov.sph" "fov.sph:1: field of view too narrow: under 2.8e-148 degrees"
+printf 'camera 0 -5 0 0 0 0 0 0 1 40\n%s\n' "$ball" > "$TMP/in/up1.sph"
+for up in "0 0 1e300" "0 0 1e-300" "0 0 3e-320"; do
+  printf 'camera 0 -5 0 0 0 0 %s 40\n%s\n' "$up" "$ball" > "$TMP/in/up.sph"
+  same_image "camera up ($up) is a direction of any length" "$TMP/in/up.sph" "$TMP/in/up1.sph"
+done
+printf 'camera 0 0 0 0 1e-200 0 0 0 1 40\n0 5 0 1 1 1 1 1 0 0 0 1\nlight 0 -10 0 1 1 1\n' > "$TMP/in/near.sph"
+printf 'camera 0 0 0 0 1 0 0 0 1 40\n0 5 0 1 1 1 1 1 0 0 0 1\nlight 0 -10 0 1 1 1\n' > "$TMP/in/unit.sph"
+same_image "an eye 1e-200 from the point it looks at sees as one 1 away" "$TMP/in/near.sph" "$TMP/in/unit.sph"
