@@ -86,24 +86,16 @@
 #define _POSIX_C_SOURCE 200809L
 #define RAY_POSIX
 #endif
-#include <ctype.h>
 #include <errno.h>
 #include <float.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #ifdef RAY_POSIX
-#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
-#endif
-#ifdef _WIN32
-#include <fcntl.h>
-#include <io.h>
-#include <process.h>
 #endif
 #include "prims.h"
 #include "kdtree.h"
@@ -1036,6 +1028,19 @@ static int degenerate(vec a, vec b, vec c)
  * threads and a progress line, reading scenes (the sphere format, OBJ and
  * NFF) into a Scene, writing the image, the command line and main().
  * ========================================================================= */
+
+/* The plumbing's own headers: characters, signals, opening files (and on
+ * Windows, binary mode and the process number). */
+#include <ctype.h>
+#include <signal.h>
+#ifdef RAY_POSIX
+#include <fcntl.h>
+#endif
+#ifdef _WIN32
+#include <fcntl.h>
+#include <io.h>
+#include <process.h>
+#endif
 
 /* ---------------------------------------------------- threads and progress */
 
