@@ -1417,8 +1417,8 @@ static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
 
 /* The largest |coordinate| of a light or the camera: two points within it
  * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
- * takes between them (to a light, from the eye) stay finite.  Beyond it, a
- * light or a view goes black without a word.  3.9e153 in doubles. */
+ * takes between them (to a light, from the eye) stay finite; beyond it, a
+ * light would light nothing and an eye see nothing.  3.9e153 in doubles. */
 #define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
 
 static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
@@ -1907,10 +1907,10 @@ static int nff_sphere(Scene *s, Lexer *lx, int mat)
 {
     real x[4];
     if (!nff_numbers(lx, "s", 4, x)) return 0;
-    /* NFF.TXT: "If the radius is negative, then only the sphere's inside
-     * is visible (objects are normally considered one sided, with the
-     * outside visible)."  ray.c draws both sides of a sphere, so the inside
-     * is seen from within either way: the radius is |r|. */
+    /* In NFF (the SPD's NFF.TXT) a negative radius means a sphere seen
+     * only from inside; objects are otherwise one-sided, seen from outside.
+     * ray.c draws both sides of a sphere, so an eye within sees the inside
+     * either way: the radius is |r|. */
     if (!(x[3] != 0)) return fail(lx->w, "sphere radius must not be 0", lx->tok);
     add_sphere(s, v3(x[0], x[1], x[2]), fabs(x[3]), mat);
     return 1;
@@ -1921,7 +1921,7 @@ static int nff_cone(Scene *s, Lexer *lx, int mat)
 {
     real x[8];
     if (!nff_numbers(lx, "c", 8, x)) return 0;
-    if (x[3] < 0 && x[7] < 0) {   /* NFF.TXT: both negative, only the inside visible; as spheres */
+    if (x[3] < 0 && x[7] < 0) {   /* seen only from inside, as a sphere's negative radius */
         x[3] = -x[3];
         x[7] = -x[7];
     }
