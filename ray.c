@@ -1567,6 +1567,19 @@ static int obj_corner(Where w, char *c, int nv, int nn, int *v, int *n)
     return 1;
 }
 
+#ifdef RAY_POSIX
+/* A mesh that a scene names must be a plain file: a directory has no
+ * lines, and a pipe or a terminal would wait for input for ever.  (Not
+ * found: fopen says so.) */
+static int plain_file(const char *name)
+{
+    struct stat st;
+    return stat(name, &st) != 0 || S_ISREG(st.st_mode);
+}
+#else
+static int plain_file(const char *name) { (void)name; return 1; }
+#endif
+
 /* Wavefront OBJ: v, vn and f (any number of corners); every other statement
  * is skipped with one warning for the file.  `from` is the scene line that
  * asked for it, for the message when it cannot be opened. */
@@ -1578,9 +1591,11 @@ static int load_obj(Scene *s, const char *file, int mat, Where from)
     char *line = malloc(OBJ_LINE), **tok = malloc(sizeof *tok * (max + 1)), first_skipped[32] = "";
     int *vi = malloc(sizeof *vi * max), *ni = malloc(sizeof *ni * max);
     Where w;
-    FILE *f = fopen(file, "r");
+    int plain = plain_file(file);
+    FILE *f = plain ? fopen(file, "r") : NULL;
     if (!line || !tok || !vi || !ni) out_of_memory();
-    if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
+    if (!plain) ok = fail(from, "mesh is not a plain file (a directory, device or pipe)", file);
+    else if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
     w.file = file;
     w.line = 0;
     while (ok && next_line(f, line, OBJ_LINE, &w, &ok)) {

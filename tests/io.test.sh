@@ -221,7 +221,12 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1\0 0\n' > "$TMP/in/nul.obj"
 printf 'mesh nul.obj 1 1 1 1 0 0 0 1\n' > "$TMP/in/nulobj.sph"
 refused "a NUL byte in an OBJ file" "$TMP/in/nulobj.sph" "nul.obj:3: NUL byte"
 printf 'mesh . 1 1 1 1 0 0 0 1\n' > "$TMP/in/dir.sph"
-refused "mesh . (a directory)" "$TMP/in/dir.sph" "/in/\.:0: cannot read mesh: Is a directory"
+refused "mesh . (a directory)" "$TMP/in/dir.sph" "dir.sph:1: mesh is not a plain file \(a directory, device or pipe\): .*/in/\.$"
+mkfifo "$TMP/in/fifo.obj"; printf 'mesh fifo.obj 1 1 1 1 0 0 0 1\n' > "$TMP/in/fifo.sph"
+timeout 10 ./ray -o "$TMP/r.ppm" "$TMP/in/fifo.sph" 2> "$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "fifo.sph:1: mesh is not a plain file" "$TMP/err" \
+  && ok "mesh naming a pipe, which would wait for ever: $(sed "s|$TMP/||g" "$TMP/err")" \
+  || bad "mesh naming a pipe: exit $rc (124: it waited), $(sed "s|$TMP/||g" "$TMP/err")"
 refused "a directory as the scene" "$TMP/in" "in:0: read error: Is a directory"
 printf 'size 8 8\n\001\377\033[31m 1 2 3\n' > "$TMP/in/bin.sph"
 refused "raw bytes in a message are escaped" "$TMP/in/bin.sph" 'bin.sph:2: unknown keyword: \\x01\\xFF\\x1B\[31m'
