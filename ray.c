@@ -102,7 +102,6 @@
 #define _POSIX_C_SOURCE 200809L
 #define RAY_POSIX
 #endif
-#include <ctype.h>
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -1727,9 +1726,25 @@ static int degenerate(vec a, vec b, vec c)
  * NFF) into a Scene, writing the image, the command line and main().
  * ========================================================================= */
 
+/* The plumbing's own headers: characters, signals, opening files (and on
+ * Windows, binary mode and the process number). */
+#include <ctype.h>
+#include <signal.h>
+#ifdef RAY_POSIX
+#include <fcntl.h>
+#endif
+#ifdef _WIN32
+#include <fcntl.h>
+#include <io.h>
+#include <process.h>
+#endif
+
 /* ---------------------------------------------------- threads and progress */
 
-typedef struct { int spp, threads, progress; } Options;
+typedef struct {
+    int spp, threads, progress;
+    double start;                 /* when the render began (now()), for the progress line */
+} Options;
 
 /* Seconds on a wall clock (processor time where there is none: with threads
  * that overstates the time). */
@@ -1751,6 +1766,18 @@ static int stderr_is_terminal(void)
 #else
     return 0;
 #endif
+}
+
+/* "ray:  42%  ETA 1:05": rows done out of rows, and the time left if the
+ * rows still to do take as long as those done so far took. */
+static void show_progress(const Options *o, int done, int rows)
+{
+    long left = (long)((now() - o->start) * (rows - done) / done + 0.5);
+    if (left >= 3600)
+        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld:%02ld ", done * 100 / rows, left / 3600,
+                left / 60 % 60, left % 60);
+    else
+        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld    ", done * 100 / rows, left / 60, left % 60);
 }
 
 static void add_counts(Counts *to, const Counts *from)
@@ -1799,21 +1826,37 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
             OMP(omp atomic capture)
             mine = ++done;
             if (o->progress && (mine * 100 / s->h != (mine - 1) * 100 / s->h))
-                fprintf(stderr, "\rray: %3d%%", mine * 100 / s->h);
+                show_progress(o, mine, s->h);
         }
         OMP(omp critical)
         add_counts(total, &wk.count);
     }
-    if (o->progress) fprintf(stderr, "\r          \r");
+    if (o->progress) fprintf(stderr, "\r%30s\r", "");
 }
 
 /* ------------------------------------------------------------- scene input */
 
 typedef struct { const char *file; int line; } Where;
 
+/* s on f, with every byte that is not printable ASCII as \xNN: a message
+ * that quotes a file never sends a terminal raw binary. */
+static void put_escaped(FILE *f, const char *s)
+{
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c >= 0x20 && c < 0x7F) putc(c, f);
+        else fprintf(f, "\\x%02X", c);
+    }
+}
+
 static int fail(Where w, const char *msg, const char *arg)
 {
-    fprintf(stderr, "%s:%d: %s%s%s\n", w.file, w.line, msg, arg ? ": " : "", arg ? arg : "");
+    fprintf(stderr, "%s:%d: %s", w.file, w.line, msg);
+    if (arg) {
+        fputs(": ", stderr);
+        put_escaped(stderr, arg);
+    }
+    fputc('\n', stderr);
     return 0;
 }
 
@@ -2091,17 +2134,70 @@ static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
     return 1;
 }
 
+/* The largest |coordinate| of a light or the camera: two points within it
+ * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
+ * takes between them (to a light, from the eye) stay finite; beyond it, a
+ * light would light nothing and an eye see nothing.  3.9e153 in doubles. */
+#define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
+
+static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
+
+/* a times the power of two that brings its largest coordinate into
+ * [1/2, 1): the same direction, and exactly the same unit() and cross()
+ * bits as a itself, yet no square of it overflows or underflows. */
+static vec pow2_scaled(vec a)
+{
+    int e;
+    real m = maxabs(a);
+    if (!(m > 0) || !isfinite(m)) return a;
+    frexp(m, &e);
+    return v3((real)ldexp(a.x, -e), (real)ldexp(a.y, -e), (real)ldexp(a.z, -e));
+}
+
+/* The narrowest field of view, in degrees, for which the image plane of
+ * camera_ray stays near enough to square its distance at 32768 pixels
+ * across: 2.8e-148 degrees in doubles. */
+static double narrowest_fov(void)
+{
+    return 2 * atan(16384 / (sqrt(sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 2))
+           * 180 / PI;
+}
+
+/* A point light, within FAR_LIMIT. */
+static int point_light(Scene *s, Where w, vec pos, vec color)
+{
+    char msg[128];
+    if (!within_far_limit(pos)) {
+        sprintf(msg, "light too far out: beyond %.2g, its squared distance to the scene overflows",
+                (double)FAR_LIMIT);
+        return fail(w, msg, NULL);
+    }
+    add_light(s, pos, color, -1);
+    return 1;
+}
+
 static int set_camera(Scene *s, Where w, const real *v)
 {
     Camera *c = &s->cam;
-    vec at = v3(v[3], v[4], v[5]), up = v3(v[6], v[7], v[8]);
+    vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
+    char msg[160];
     c->eye = v3(v[0], v[1], v[2]);
-    if (!(dot(sub(at, c->eye), sub(at, c->eye)) > 0))
+    if (!within_far_limit(c->eye) || !within_far_limit(at)) {
+        sprintf(msg, "camera too far out: beyond %.2g, squared distances from the eye overflow",
+                (double)FAR_LIMIT);
+        return fail(w, msg, NULL);
+    }
+    if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
         return fail(w, "camera looks at its own eye", NULL);
     if (!(v[9] > 0 && v[9] < 180))
         return fail(w, "field of view must be between 0 and 180 degrees", NULL);
+    if (!(v[9] >= narrowest_fov())) {
+        sprintf(msg, "field of view too narrow: under %.2g degrees the image plane is so far away"
+                " that its squared distance overflows", narrowest_fov());
+        return fail(w, msg, NULL);
+    }
     c->tan_half = tan(v[9] * PI / 360);
-    c->fwd = unit(sub(at, c->eye));
+    c->fwd = unit(pow2_scaled(sub(at, c->eye)));
     c->right = cross(c->fwd, up);
     if (!(dot(c->right, c->right) > 0)) return fail(w, "camera up is parallel to its view", NULL);
     c->right = unit(c->right);
@@ -2142,17 +2238,29 @@ static int tokens(char *line, char **tok, int max)
     }
 }
 
-/* Reads the next line of f into line; 0 at the end or on an over-long line
- * (then *ok is cleared and the message printed). */
+#define BOM "\xEF\xBB\xBF"          /* UTF-8's byte order mark, which some editors write */
+
+/* Reads the next line of f into line, without its end: "\n", "\r\n" or a
+ * lone "\r" (old Mac files) each end a line.  A byte order mark before the
+ * first line is skipped.  0 at the end of the file, or after a message
+ * (*ok cleared) on an over-long line or a NUL byte, which no text has. */
 static int next_line(FILE *f, char *line, int size, Where *w, int *ok)
 {
-    if (!fgets(line, size, f)) return 0;
+    int c = getc(f), n = 0;
+    if (c == EOF) return 0;
     w->line++;
-    if (!strchr(line, '\n') && !feof(f)) {
-        char msg[64];
-        sprintf(msg, "line longer than %d characters", size - 2);
-        return *ok = fail(*w, msg, NULL);
+    for (; c != EOF && c != '\n' && c != '\r'; c = getc(f)) {
+        if (c == 0) return *ok = fail(*w, "NUL byte: this is not a text file", NULL);
+        if (n == size - 1) {
+            char msg[64];
+            sprintf(msg, "line longer than %d characters", size - 1);
+            return *ok = fail(*w, msg, NULL);
+        }
+        line[n++] = (char)c;
     }
+    if (c == '\r' && (c = getc(f)) != '\n' && c != EOF) ungetc(c, f);
+    line[n] = 0;
+    if (w->line == 1 && !strncmp(line, BOM, 3)) memmove(line, line + 3, (size_t)n - 2);
     return 1;
 }
 
@@ -2178,6 +2286,19 @@ static int obj_corner(Where w, char *c, int nv, int nn, int *v, int *n)
     return 1;
 }
 
+#ifdef RAY_POSIX
+/* A mesh that a scene names must be a plain file: a directory has no
+ * lines, and a pipe or a terminal would wait for input for ever.  (Not
+ * found: fopen says so.) */
+static int plain_file(const char *name)
+{
+    struct stat st;
+    return stat(name, &st) != 0 || S_ISREG(st.st_mode);
+}
+#else
+static int plain_file(const char *name) { (void)name; return 1; }
+#endif
+
 /* Wavefront OBJ: v, vn and f (any number of corners); every other statement
  * is skipped with one warning for the file.  `from` is the scene line that
  * asked for it, for the message when it cannot be opened. */
@@ -2189,9 +2310,11 @@ static int load_obj(Scene *s, const char *file, int mat, Where from)
     char *line = malloc(OBJ_LINE), **tok = malloc(sizeof *tok * (max + 1)), first_skipped[32] = "";
     int *vi = malloc(sizeof *vi * max), *ni = malloc(sizeof *ni * max);
     Where w;
-    FILE *f = fopen(file, "r");
+    int plain = plain_file(file);
+    FILE *f = plain ? fopen(file, "r") : NULL;
     if (!line || !tok || !vi || !ni) out_of_memory();
-    if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
+    if (!plain) ok = fail(from, "mesh is not a plain file (a directory, device or pipe)", file);
+    else if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
     w.file = file;
     w.line = 0;
     while (ok && next_line(f, line, OBJ_LINE, &w, &ok)) {
@@ -2219,20 +2342,56 @@ static int load_obj(Scene *s, const char *file, int mat, Where from)
             sprintf(first_skipped, "%.20s", tok[0]);
         }
     }
+    if (ok && ferror(f)) ok = fail(w, "cannot read mesh", strerror(errno)); /* mesh . */
     if (f) fclose(f);
-    if (ok && skipped)
+    if (ok && skipped) {
         fprintf(stderr, "%s:%d: warning: skipped %d statement%s that are not v, vn or f"
-                " (the first: %s)\n",
-                file, skipped_line, skipped, skipped == 1 ? "" : "s", first_skipped);
+                " (the first: ", file, skipped_line, skipped, skipped == 1 ? "" : "s");
+        put_escaped(stderr, first_skipped);
+        fputs(")\n", stderr);
+    }
     free(line); free(tok); free(vi); free(ni);
     return ok;
+}
+
+/* Windows paths separate directories with \ as well as /, and may start
+ * with a drive ("C:"); elsewhere \ and : are ordinary characters of a file
+ * name.  -DRAY_DOS_PATHS gives the Windows rule anywhere, for the tests. */
+#if defined(_WIN32) && !defined(RAY_DOS_PATHS)
+#define RAY_DOS_PATHS
+#endif
+
+static int path_separator(int c)
+{
+#ifdef RAY_DOS_PATHS
+    return c == '/' || c == '\\' || c == ':';
+#else
+    return c == '/';
+#endif
+}
+
+/* Where the file's own name starts in path: after the last separator. */
+static const char *file_part(const char *path)
+{
+    const char *p, *name = path;
+    for (p = path; *p; p++)
+        if (path_separator(*p)) name = p + 1;
+    return name;
+}
+
+/* A path from the root (or a drive), which no directory may prefix. */
+static int absolute(const char *path)
+{
+#ifdef RAY_DOS_PATHS
+    if (path[0] && path[1] == ':') return 1;
+#endif
+    return path_separator(path[0]);
 }
 
 /* A path named in a scene is relative to the scene's directory. */
 static char *beside(const char *scene, const char *name)
 {
-    const char *slash = strrchr(scene, '/');
-    size_t dir = name[0] == '/' || !slash ? 0 : (size_t)(slash - scene + 1);
+    size_t dir = absolute(name) ? 0 : (size_t)(file_part(scene) - scene);
     char *p = malloc(dir + strlen(name) + 1);
     if (!p) out_of_memory();
     memcpy(p, scene, dir);
@@ -2293,11 +2452,9 @@ static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
     }
     if (!strcmp(k, "camera"))
         return numbers(w, k, tok, ntok, 1, 10, v) && set_camera(s, w, v);
-    if (!strcmp(k, "light")) {
-        if (!numbers(w, k, tok, ntok, 1, 6, v)) return 0;
-        add_light(s, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]), -1);
-        return 1;
-    }
+    if (!strcmp(k, "light"))
+        return numbers(w, k, tok, ntok, 1, 6, v)
+               && point_light(s, w, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]));
     if (!strcmp(k, "pixel")) {
         if (ntok != 2
             || (strcmp(tok[1], "corner") && strcmp(tok[1], "centre") && strcmp(tok[1], "center")))
@@ -2432,7 +2589,16 @@ static int load_sph(Scene *s, FILE *f, Where w)
 /* NFF is a stream of blank-separated tokens, not of lines (a cone's eight
  * numbers may sit on one line or three), so it is read a token at a time.
  * `again` hands the last token out once more, for a look ahead. */
-typedef struct { FILE *f; Where w; int c, again; char tok[256]; } Lexer;
+typedef struct { FILE *f; Where w; int c, prev, again; char tok[256]; } Lexer;
+
+/* On to the next character, counting lines: "\n", "\r\n" and a lone
+ * "\r" each end one. */
+static void advance(Lexer *lx)
+{
+    if (lx->c == '\r' || (lx->c == '\n' && lx->prev != '\r')) lx->w.line++;
+    lx->prev = lx->c;
+    lx->c = getc(lx->f);
+}
 
 /* The next token into lx->tok: 1, or 0 at the end of the file, or -1 after
  * saying what is wrong. */
@@ -2441,12 +2607,15 @@ static int next_token(Lexer *lx)
     int n = 0;
     if (lx->again) { lx->again = 0; return 1; }
     for (;;) {
-        for (; blank(lx->c); lx->c = getc(lx->f))
-            if (lx->c == '\n') lx->w.line++;
+        while (blank(lx->c)) advance(lx);
         if (lx->c != '#') break;
-        while (lx->c != '\n' && lx->c != EOF) lx->c = getc(lx->f);
+        while (lx->c != '\n' && lx->c != '\r' && lx->c != EOF && lx->c != 0) advance(lx);
     }
-    for (; lx->c != EOF && !blank(lx->c); lx->c = getc(lx->f)) {
+    for (; lx->c != EOF && !blank(lx->c); advance(lx)) {
+        if (lx->c == 0) {
+            fail(lx->w, "NUL byte: this is not a text file", NULL);
+            return -1;
+        }
         if (n == (int)sizeof lx->tok - 1) {
             fail(lx->w, "token longer than 255 characters", NULL);
             return -1;
@@ -2527,13 +2696,14 @@ static int nff_light(Scene *s, Lexer *lx)
 {
     real x[3], rgb[3] = { 1, 1, 1 };
     int got;
+    Where at;
     if (!nff_numbers(lx, "l", 3, x)) return 0;
+    at = lx->w;                              /* before the look ahead */
     got = next_token(lx);                    /* a colour, or the next entity */
     if (got < 0) return 0;
     lx->again = got > 0;
     if (got > 0 && strchr("+-.0123456789", lx->tok[0]) && !nff_numbers(lx, "l", 3, rgb)) return 0;
-    add_light(s, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]), -1);
-    return 1;
+    return point_light(s, at, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]));
 }
 
 /* b r g b: the colour of rays that hit nothing. */
@@ -2563,8 +2733,12 @@ static int nff_sphere(Scene *s, Lexer *lx, int mat)
 {
     real x[4];
     if (!nff_numbers(lx, "s", 4, x)) return 0;
-    if (!(x[3] > 0)) return fail(lx->w, "sphere radius must be positive", lx->tok);
-    add_sphere(s, v3(x[0], x[1], x[2]), x[3], mat);
+    /* In NFF (the SPD's NFF.TXT) a negative radius means a sphere seen
+     * only from inside; objects are otherwise one-sided, seen from outside.
+     * ray.c draws both sides of a sphere, so an eye within sees the inside
+     * either way: the radius is |r|. */
+    if (!(x[3] != 0)) return fail(lx->w, "sphere radius must not be 0", lx->tok);
+    add_sphere(s, v3(x[0], x[1], x[2]), fabs(x[3]), mat);
     return 1;
 }
 
@@ -2572,7 +2746,23 @@ static int nff_sphere(Scene *s, Lexer *lx, int mat)
 static int nff_cone(Scene *s, Lexer *lx, int mat)
 {
     real x[8];
-    return nff_numbers(lx, "c", 8, x) && check_cone(s, lx->w, x, mat);
+    if (!nff_numbers(lx, "c", 8, x)) return 0;
+    if (x[3] < 0 && x[7] < 0) {   /* seen only from inside, as a sphere's negative radius */
+        x[3] = -x[3];
+        x[7] = -x[7];
+    }
+    return check_cone(s, lx->w, x, mat);
+}
+
+/* The rest of a byte order mark, whose first byte is lx->c. */
+static int skip_bom(Lexer *lx)
+{
+    int b1 = getc(lx->f), b2 = getc(lx->f);
+    if (b1 != (unsigned char)BOM[1] || b2 != (unsigned char)BOM[2])
+        return fail(lx->w, "not an NFF file: it starts with byte 0xEF, yet no UTF-8 byte order mark",
+                    NULL);
+    lx->c = getc(lx->f);
+    return 1;
 }
 
 static int load_nff(Scene *s, FILE *f, Where w)
@@ -2580,7 +2770,8 @@ static int load_nff(Scene *s, FILE *f, Where w)
     Lexer lx;
     int mat = -1, k, ok = 1, got = 1;
     double intensity;
-    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.again = 0;
+    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.prev = 0; lx.again = 0;
+    if (lx.c == (unsigned char)BOM[0] && !skip_bom(&lx)) return 0;
     s->tir_reflect = 1;                          /* the SPD's rule */
     while (ok && (got = next_token(&lx)) > 0) {
         const char *t = lx.tok;
@@ -2608,23 +2799,6 @@ static int load_nff(Scene *s, FILE *f, Where w)
     return ok;
 }
 
-/* The scene by its name: NFF when it ends .nff, else the sphere format. */
-static int load_scene(Scene *s, const char *file)
-{
-    Where w = { file, 0 };
-    FILE *f = fopen(file, "r");
-    size_t len = strlen(file);
-    int ok;
-    default_scene(s);
-    if (!f) return fail(w, "cannot open scene", strerror(errno));
-    ok = len > 4 && !strcmp(file + len - 4, ".nff") ? load_nff(s, f, w) : load_sph(s, f, w);
-    if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
-    fclose(f);
-    return ok;
-}
-
-/* ------------------------------------------------------------------ output */
-
 /* Does name end with ext (given in lower case), in any case? */
 static int has_extension(const char *name, const char *ext)
 {
@@ -2634,6 +2808,23 @@ static int has_extension(const char *name, const char *ext)
         if (tolower((unsigned char)name[n - k + i]) != ext[i]) return 0;
     return 1;
 }
+
+/* The scene by its name: NFF when it ends .nff (or .NFF), else the sphere
+ * format. */
+static int load_scene(Scene *s, const char *file)
+{
+    Where w = { file, 0 };
+    FILE *f = fopen(file, "r");
+    int ok;
+    default_scene(s);
+    if (!f) return fail(w, "cannot open scene", strerror(errno));
+    ok = has_extension(file, ".nff") ? load_nff(s, f, w) : load_sph(s, f, w);
+    if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
+    fclose(f);
+    return ok;
+}
+
+/* ------------------------------------------------------------------ output */
 
 enum { FORMAT_PPM, FORMAT_PNG, FORMAT_PFM, FORMAT_OTHER };
 
@@ -2794,39 +2985,176 @@ static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain
 
 /* Where the image goes.  It is opened before the render, so that a bad -o
  * fails at once rather than after a long render.  A new or plain file is
- * written as FILE.tmp and renamed over FILE at the end, so that a failure
- * never leaves a half-written image behind.  Anything else (stdout, a device
- * such as /dev/null, a pipe, a symbolic link) is written in place and never
- * renamed over or removed. */
+ * written to a temporary file of this run's own beside it (FILE.tmp.PID),
+ * which is renamed over FILE at the end: a failure or an interrupt never
+ * leaves a half-written image, and keeps the old one.  Anything else
+ * (stdout, a device such as /dev/null, a pipe, a symbolic link) is written
+ * in place and never renamed over or removed. */
 typedef struct { FILE *f; const char *name; char *tmp; int format; } Output;
 
+/* The temporary file's name, for on_signal, which can be handed nothing:
+ * the one global of ray.c (the card has its own).  It is written before the
+ * handler is installed, and the handler only reads it. */
+static char signal_tmp[4096];
+
+/* Ctrl-C (SIGINT), SIGTERM, or a closed terminal (SIGHUP) during a render:
+ * the temporary file is removed, then the signal raised again with its
+ * default action, so that the program ends as that signal ends it (a shell
+ * shows 128 + its number) and the old output stays.  Only calls that are
+ * safe in a signal handler: unlink (remove, where there is no unlink),
+ * signal and raise. */
+static void on_signal(int sig)
+{
 #ifdef RAY_POSIX
-/* Absent, or a plain file (not a link, a device or a pipe)? */
-static int replaceable(const char *name)
+    unlink(signal_tmp);
+#else
+    remove(signal_tmp);
+#endif
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* Is sig ignored (as nohup, or a shell for a background job, leaves it)?
+ * Then it stays ignored. */
+static int ignored(int sig)
+{
+#ifdef RAY_POSIX
+    struct sigaction sa;
+    return sigaction(sig, NULL, &sa) == 0 && sa.sa_handler == SIG_IGN;
+#else
+    (void)sig;
+    return 0;
+#endif
+}
+
+/* on_signal for the temporary file tmp, or with tmp NULL the default
+ * action again (the file is renamed into place, or gone).  A name too long
+ * for signal_tmp, which no system takes, is left to the default action. */
+static void catch_signals(const char *tmp)
+{
+#ifdef RAY_POSIX
+    static const int sigs[] = { SIGINT, SIGTERM, SIGHUP };
+#else
+    static const int sigs[] = { SIGINT, SIGTERM };
+#endif
+    size_t i;
+    if (tmp && strlen(tmp) >= sizeof signal_tmp) return;
+    if (tmp) strcpy(signal_tmp, tmp);
+    for (i = 0; i < sizeof sigs / sizeof *sigs; i++)
+        if (!ignored(sigs[i])) signal(sigs[i], tmp ? on_signal : SIG_DFL);
+}
+
+/* Nothing but this run may have opened the file: created here (O_EXCL: not
+ * if it exists, and never through a symbolic link), or NULL with errno
+ * EEXIST.  Without POSIX, the best plain C can do: fail if it can be read. */
+static FILE *create_new(const char *name)
+{
+#ifdef RAY_POSIX
+    int fd = open(name, O_WRONLY | O_CREAT | O_EXCL, 0666);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb");
+    if (fd >= 0 && !f) { close(fd); unlink(name); }
+    return f;
+#else
+    FILE *f = fopen(name, "rb");
+    if (f) { fclose(f); errno = EEXIST; return NULL; }
+    return fopen(name, "wb");
+#endif
+}
+
+/* This process's number, to tell its temporary files from another run's. */
+static long process_id(void)
+{
+#if defined(RAY_POSIX)
+    return (long)getpid();
+#elif defined(_WIN32)
+    return (long)_getpid();
+#else
+    return (long)time(NULL);
+#endif
+}
+
+/* A temporary file beside name that no other run shares: name.tmp.PID, or
+ * name.tmp.PID.K when that exists (left by a run that was killed). */
+static FILE *create_temp(const char *name, char **tmp)
+{
+    int k;
+    FILE *f = NULL;
+    *tmp = malloc(strlen(name) + 48);
+    if (!*tmp) return NULL;
+    for (k = 0; k < 100 && !f; k++) {
+        if (k) sprintf(*tmp, "%s.tmp.%ld.%d", name, process_id(), k);
+        else sprintf(*tmp, "%s.tmp.%ld", name, process_id());
+        f = create_new(*tmp);
+        if (!f && errno != EEXIST) break;
+    }
+    return f;
+}
+
+enum { IN_PLACE, VIA_TEMP, REFUSED };
+
+#ifdef RAY_POSIX
+/* How -o FILE is written: a plain file or a new one through a temporary
+ * (*mode: the old file's permissions, which the new one keeps; -1 for a new
+ * file), anything else in place.  A read-only file is refused, with a
+ * message: replacing it would defeat its protection (root may write any
+ * file, so its mode bits are asked too). */
+static int output_kind(const char *name, int *mode)
 {
     struct stat st;
-    return lstat(name, &st) != 0 ? errno == ENOENT : S_ISREG(st.st_mode);
+    *mode = -1;
+    if (lstat(name, &st) != 0) return errno == ENOENT ? VIA_TEMP : IN_PLACE;
+    if (!S_ISREG(st.st_mode)) return IN_PLACE;
+    if (access(name, W_OK) != 0 || !(st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH))) {
+        fprintf(stderr, "%s: is read-only; not replaced (make it writable, or write elsewhere)\n",
+                name);
+        return REFUSED;
+    }
+    *mode = (int)(st.st_mode & 07777);
+    return VIA_TEMP;
 }
 #else
-static int replaceable(const char *name) { (void)name; return 1; }
+static int output_kind(const char *name, int *mode)
+{
+    FILE *f = fopen(name, "rb");
+    *mode = -1;
+    if (f) {
+        fclose(f);
+        f = fopen(name, "r+b");     /* opens for writing without changing it */
+        if (!f) {
+            fprintf(stderr, "%s: is read-only; not replaced (make it writable, or write elsewhere)\n",
+                    name);
+            return REFUSED;
+        }
+        fclose(f);
+    }
+    return VIA_TEMP;
+}
 #endif
 
+/* Opens -o name for writing (see Output).  0 after a message. */
 static int open_output(Output *o, const char *name)
 {
+    int mode, kind;
     o->name = name;
     o->tmp = NULL;
     o->f = stdout;
     o->format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
-    if (!strcmp(name, "-")) return 1;
-    if (replaceable(name)) {
-        o->tmp = malloc(strlen(name) + 5);
-        if (!o->tmp) return 0;
-        sprintf(o->tmp, "%s.tmp", name);
-        errno = EEXIST;               /* the message if FILE.tmp is no plain file */
-        o->f = replaceable(o->tmp) ? fopen(o->tmp, "wb") : NULL;
-    } else
-        o->f = fopen(name, "wb");
-    if (o->f) return 1;
+    if (!strcmp(name, "-")) {
+#ifdef _WIN32
+        _setmode(_fileno(stdout), _O_BINARY);    /* P6 and PNG bytes as they are: no \r added */
+#endif
+        return 1;
+    }
+    kind = output_kind(name, &mode);
+    if (kind == REFUSED) return 0;
+    o->f = kind == VIA_TEMP ? create_temp(name, &o->tmp) : fopen(name, "wb");
+#ifdef RAY_POSIX
+    if (o->f && mode >= 0) fchmod(fileno(o->f), (mode_t)mode);
+#endif
+    if (o->f) {
+        if (o->tmp) catch_signals(o->tmp);
+        return 1;
+    }
     fprintf(stderr, "%s: cannot write: %s\n", o->tmp ? o->tmp : name, strerror(errno));
     free(o->tmp);
     return 0;
@@ -2837,6 +3165,7 @@ static void discard_output(Output *o)
 {
     if (o->f != stdout) fclose(o->f);
     if (o->tmp) remove(o->tmp);
+    if (o->tmp) catch_signals(NULL);
     free(o->tmp);
 }
 
@@ -2857,6 +3186,17 @@ static void write_pfm(FILE *f, const Image *img)
         }
 }
 
+/* rename() over an existing file: POSIX replaces it in one step; Windows
+ * refuses, so there the old file is removed first (for a moment there is
+ * neither: the best plain C can do). */
+static int replace_file(const char *from, const char *to)
+{
+#ifdef _WIN32
+    remove(to);
+#endif
+    return rename(from, to);
+}
+
 /* The image in the output's format, then the file closed and, if it was
  * written as a temporary, renamed into place; on failure a message and no
  * file.  A PNG of sRGB bytes says so. */
@@ -2872,11 +3212,12 @@ static int write_image(Output *o, const Image *img, int plain)
         write_ppm(o->f, img->bytes, img->w, img->h, plain);
     ok = ok && fflush(o->f) == 0 && !ferror(o->f);
     if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
-    if (ok && o->tmp) ok = rename(o->tmp, o->name) == 0;
+    if (ok && o->tmp) ok = replace_file(o->tmp, o->name) == 0;
     if (!ok) {
         fprintf(stderr, "%s: cannot write: %s\n", o->name, strerror(errno));
         if (o->tmp) remove(o->tmp);
     }
+    if (o->tmp) catch_signals(NULL);
     free(o->tmp);
     return ok;
 }
@@ -2912,6 +3253,87 @@ static void usage(FILE *to)
           "  --help     this text\n", to);
 }
 
+#define RAY_VERSION "1.0"
+
+static void version(void)
+{
+#ifdef _OPENMP
+    const char *threads = "OpenMP threads";
+#else
+    const char *threads = "one thread, no OpenMP";
+#endif
+    printf("ray " RAY_VERSION ", Whitted ray tracer in C99 (%s, %s)\n",
+           sizeof(real) == sizeof(float) ? "float" : "double", threads);
+}
+
+/* The value of option opt ("-n", "--accel") if argv[*i] is that option:
+ * attached ("-n4", "--accel=kd") or the next argument ("-n 4"), which is
+ * then used up.  NULL if argv[*i] is another option; a usage error (exit 2)
+ * if the value is missing. */
+static const char *option_value(int argc, char **argv, int *i, const char *opt)
+{
+    const char *a = argv[*i];
+    size_t n = strlen(opt);
+    if (strncmp(a, opt, n)) return NULL;
+    if (a[n] && opt[1] != '-') return a + n;
+    if (a[n]) return a[n] == '=' ? a + n + 1 : NULL;
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "ray: %s needs a value (see ray --help)\n", opt);
+        exit(2);
+    }
+    return argv[++*i];
+}
+
+/* --accel's value, or a usage error (exit 2) that lists the choices. */
+static const char *accel_arg(const char *v)
+{
+    if (strcmp(v, "kd") && strcmp(v, "none") && strcmp(v, "auto")) {
+        fprintf(stderr, "ray: --accel takes kd (the kd-tree), none (every object) or auto, not %s\n",
+                v);
+        exit(2);
+    }
+    return v;
+}
+
+/* The path tracer's estimator named by --estimator, or exit with the choices. */
+static int estimator_arg(const char *v)
+{
+    if (!strcmp(v, "bsdf")) return BSDF_ONLY;
+    if (!strcmp(v, "nee")) return NEE;
+    if (strcmp(v, "mis")) {
+        fprintf(stderr, "ray: --estimator takes bsdf (BSDF sampling only), nee (next-event"
+                " estimation) or mis, not %s\n", v);
+        exit(2);
+    }
+    return MIS;
+}
+
+/* -t asks for threads that a build without OpenMP does not have: said once. */
+static void warn_threads(int threads)
+{
+#ifndef _OPENMP
+    if (threads) fprintf(stderr, "ray: warning: -t %d is ignored: built without OpenMP, one thread\n", threads);
+#else
+    (void)threads;
+#endif
+}
+
+/* Is -o name another file than the scene?  Else a message: the render
+ * would overwrite its own scene.  The same file by device and inode under
+ * POSIX (through links, and however the path is spelled), else by name. */
+static int apart(const char *scene, const char *name)
+{
+#ifdef RAY_POSIX
+    struct stat a, b;
+    int same = stat(scene, &a) == 0 && stat(name, &b) == 0 && a.st_dev == b.st_dev
+               && a.st_ino == b.st_ino;
+#else
+    int same = !strcmp(scene, name);
+#endif
+    if (same) fprintf(stderr, "ray: -o %s is the scene file; not overwritten\n", name);
+    return !same;
+}
+
 /* A whole number from 1 to max, or exit with a message naming the option. */
 static int int_arg(const char *opt, const char *arg, int max)
 {
@@ -2940,10 +3362,8 @@ static int output_usable(const char *name, int plain)
 
 static char *default_output(const char *scene)
 {
-    const char *base = strrchr(scene, '/'), *dot;
+    const char *base = file_part(scene), *dot = strrchr(base, '.');
     char *out;
-    base = base ? base + 1 : scene;
-    dot = strrchr(base, '.');
     out = malloc(strlen(base) + 5);
     if (!out) out_of_memory();
     sprintf(out, "%.*s.ppm", dot ? (int)(dot - base) : (int)strlen(base), base);
@@ -3079,8 +3499,8 @@ static int new_image(Image *img, int w, int h, int floats, int srgb)
     return img->bytes || img->floats;
 }
 
-/* -s WxH onto the scene; 0 with a message when it is not such a size. */
-static int set_size(Scene *s, const char *size)
+/* -s WxH into *w, *h; 0 with a message when it is not such a size. */
+static int parse_size(const char *size, int *w, int *h)
 {
     char *x, *end = NULL;
     long fw = strtol(size, &x, 10), fh = *x == 'x' ? strtol(x + 1, &end, 10) : 0;
@@ -3088,7 +3508,7 @@ static int set_size(Scene *s, const char *size)
         fprintf(stderr, "ray: -s needs WxH, like 640x480, not %s\n", size);
         return 0;
     }
-    if (!check_size((double)fw, (double)fh, &s->w, &s->h)) {
+    if (!check_size((double)fw, (double)fh, w, h)) {
         fprintf(stderr, "ray: -s %s: " SIZE_RULE "\n", size);
         return 0;
     }
@@ -3098,41 +3518,38 @@ static int set_size(Scene *s, const char *size)
 int main(int argc, char **argv)
 {
     Scene s;
-    Options o = { 0, 0, 0 };
+    Options o = { 0, 0, 0, 0 };
     Counts st;
     Output out;
     Image img;
     const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
     char *auto_name = NULL;
-    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, integrator = -1, estimator = -1;
-    int roulette = 1;
+    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, w = 0, h = 0, integrator = -1;
+    int estimator = -1, roulette = 1;
     long seed = -1;
     double t0, load, build;
     clock_t c0;
 
     for (i = 1; i < argc; i++) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        const char *a = argv[i], *v;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
-        else if (!strcmp(a, "-o") && next) name = argv[++i];
-        else if (!strcmp(a, "-s") && next) size = argv[++i];
-        else if (!strcmp(a, "-n")) { o.spp = int_arg(a, next, 1 << 20); i++; }
-        else if (!strcmp(a, "-d")) { depth = int_arg(a, next, 64); i++; }
-        else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
+        else if (!strcmp(a, "--version")) { version(); return 0; }
+        else if ((v = option_value(argc, argv, &i, "-o"))) name = v;
+        else if ((v = option_value(argc, argv, &i, "-s"))) size = v;
+        else if ((v = option_value(argc, argv, &i, "-n"))) o.spp = int_arg("-n", v, 1 << 20);
+        else if ((v = option_value(argc, argv, &i, "-d"))) depth = int_arg("-d", v, 64);
+        else if ((v = option_value(argc, argv, &i, "-t"))) o.threads = int_arg("-t", v, 4096);
+        else if ((v = option_value(argc, argv, &i, "--accel"))) accel = accel_arg(v);
         else if (!strcmp(a, "--p3")) plain = 1;
         else if (!strcmp(a, "--gamma")) gamma = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
-        else if (!strcmp(a, "--accel") && next
-                 && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
-            accel = argv[++i];
         else if (!strcmp(a, "--pt")) integrator = PATH;
         else if (!strcmp(a, "--whitted")) integrator = WHITTED;
         else if (!strcmp(a, "--no-roulette")) roulette = 0;
-        else if (!strcmp(a, "--seed")) { seed = int_arg(a, next, 2147483647) - 1; i++; }
-        else if (!strcmp(a, "--estimator") && next
-                 && (!strcmp(next, "bsdf") || !strcmp(next, "nee") || !strcmp(next, "mis")))
-            estimator = !strcmp(argv[++i], "bsdf") ? BSDF_ONLY : !strcmp(argv[i], "nee") ? NEE : MIS;
+        else if ((v = option_value(argc, argv, &i, "--seed"))) seed = int_arg("--seed", v, 2147483647) - 1;
+        else if ((v = option_value(argc, argv, &i, "--estimator"))) estimator = estimator_arg(v);
         else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "ray: unknown option, or a bad or missing value: %s\n", a);
+            fprintf(stderr, "ray: unknown option: %s\n", a);
             usage(stderr);
             return 2;
         } else if (scene) {
@@ -3142,9 +3559,16 @@ int main(int argc, char **argv)
         else scene = a;
     }
     if (!scene) { usage(stderr); return 2; }
-    if (name && !output_usable(name, plain)) return 2;
+    if (!name) name = auto_name = default_output(scene);
+    if ((size && !parse_size(size, &w, &h)) || !output_usable(name, plain)
+        || !apart(scene, name)) {
+        free(auto_name);
+        return 2;
+    }
+    warn_threads(o.threads);
     load = now();
-    ok = load_scene(&s, scene) && (!size || set_size(&s, size));
+    ok = load_scene(&s, scene);
+    if (ok && size) { s.w = w; s.h = h; }
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
     if (depth) s.depth = s.max_rays = depth;
@@ -3153,7 +3577,6 @@ int main(int argc, char **argv)
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
-    if (ok && !name) name = auto_name = default_output(scene);
     if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
 
     if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, s.integrator == PATH || gamma)) {
@@ -3166,7 +3589,7 @@ int main(int argc, char **argv)
     memset(&st, 0, sizeof st);
     if (s.integrator == PATH ? s.warning[0] : s.whitted_warning[0])
         fprintf(stderr, "%s\n", s.integrator == PATH ? s.warning : s.whitted_warning);
-    t0 = now();
+    t0 = o.start = now();
     c0 = clock();
     render(&s, &o, &img, &st);
     t0 = now() - t0;
