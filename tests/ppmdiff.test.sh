@@ -61,6 +61,22 @@ run --psnr 38.5 "$TMP/a.ppm" "$TMP/c.ppm";  expect "--psnr 38.5 passes 38.59 dB"
 run --psnr=38.7 "$TMP/a.ppm" "$TMP/c.ppm";  expect "--psnr=38.7 fails 38.59 dB" 1
 run --psnr 99 "$TMP/a.ppm" "$TMP/a.ppm";    expect "--psnr passes identical images" 0
 
+# The mean difference, B - A, signed: c is 3 channels of 12 up by 6 (+1.5);
+# noise is one channel up by 1 and one down by 1 (mean 0); dark is every
+# channel one level down (mean -1).  Both have max 1: only the mean tells
+# a bias from noise.
+printf 'P3\n4 1\n255\n11 20 30  40 50 60  70 80 90  100 110 119\n' >"$TMP/noise.ppm"
+printf 'P3\n4 1\n255\n9 19 29  39 49 59  69 79 89  99 109 119\n' >"$TMP/dark.ppm"
+run "$TMP/a.ppm" "$TMP/c.ppm";  expect "mean diff: 3 channels of 12 up by 6 is +1.5" 1 "mean diff +1.5000"
+run "$TMP/dark.ppm" "$TMP/a.ppm"; expect "mean diff is B - A: +1 from dark to a" 1 "mean diff +1.0000"
+run -t 1 --bias 0.5 "$TMP/a.ppm" "$TMP/noise.ppm"
+expect "--bias 0.5 passes noise of one level either way (mean 0)" 0 "max |diff| 1" "mean diff +0.0000"
+run -t 1 --bias 0.5 "$TMP/a.ppm" "$TMP/dark.ppm"
+expect "--bias 0.5 fails every channel one level down (max 1, mean -1)" 1 "mean diff -1.0000" "|mean diff| 1.0000 > 0.5"
+run --bias 1.5 "$TMP/a.ppm" "$TMP/c.ppm";    expect "--bias 1.5 alone passes mean +1.5 (max not checked)" 0
+run --bias=1.49 "$TMP/a.ppm" "$TMP/c.ppm";   expect "--bias=1.49 fails mean +1.5" 1 "|mean diff| 1.5000 > 1.49"
+run --bias -1 "$TMP/a.ppm" "$TMP/a.ppm";     expect "--bias below 0: exit 2" 2 "--bias"
+
 run "$TMP/a.ppm" "$TMP/square.ppm"
 expect "size mismatch: exit 2 naming both sizes" 2 "4x1" "2x2" "a.ppm" "square.ppm"
 

@@ -20,6 +20,18 @@ static void report(int ok, const char *name, const char *fmt, double a, double b
     failures += !ok;
 }
 
+/* load_scene, or a FAIL line for the test `name` and 0: the caller then
+ * returns without touching the scene, whose arrays may be short or empty. */
+static int load_or_fail(Scene *s, const char *file, const char *name)
+{
+    if (load_scene(s, file)) return 1;
+    printf("FAIL %s (%s did not load)\n", name, file);
+    fflush(stdout);
+    failures++;
+    free_scene(s);
+    return 0;
+}
+
 static int near(double a, double b, double tol) { return fabs(a - b) <= tol; }
 
 static void test_vectors(void)
@@ -519,6 +531,68 @@ static void test_float_range(void)
            "%g%.0g", ok, 0);
 }
 
+/* A room, a closed box of 12 triangles (4 x 4 x 3), with a point light just
+ * under its ceiling and a ball on its floor.  Each pixel that sees the floor
+ * is compared with the exact answer: white, kd 1, no ambient, so the light's
+ * cos(angle to the normal) where the segment from the point to the light
+ * misses the ball, and black where it crosses the ball.  A shadow ray that
+ * counts what lies beyond the light (tmax = infinity instead of the light's
+ * distance) meets the ceiling and turns the whole floor black.  The tree =
+ * loop tests cannot see that, as both sides share shadow_ray; nor can a
+ * scene with nothing beyond its lights.  Through the tree and the loop. */
+static void test_light_under_ceiling(void)
+{
+    static const int face[6][4] = { { 0, 1, 3, 2 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 },
+                                    { 2, 3, 7, 6 }, { 0, 2, 6, 4 }, { 1, 3, 7, 5 } };
+    Scene s = tri_scene(0);
+    Worker wk;
+    vec light = v3(0.4, -0.3, 2.8), ball = v3(-0.9, -0.5, 0.5);
+    real v[10] = { 0, -1.8, 2.5, 0, 0.3, 0, 0, 0, 1, 90 };
+    int c[8], k, i, j, accel, W = 64;
+    memset(&wk, 0, sizeof wk);
+    for (k = 0; k < 8; k++)      /* corner k: x, y, z high by bits 1, 2, 4 */
+        c[k] = add_vertex(&s, v3(k & 1 ? 2 : -2, k & 2 ? 2 : -2, k & 4 ? 3 : 0));
+    for (k = 0; k < 6; k++) {    /* face 0, triangles 0 and 1, is the floor */
+        add_triangle(&s, c[face[k][0]], c[face[k][1]], c[face[k][2]], -1, -1, -1, 0);
+        add_triangle(&s, c[face[k][0]], c[face[k][2]], c[face[k][3]], -1, -1, -1, 0);
+    }
+    add_sphere(&s, ball, 0.5, 0);
+    add_light(&s, light, v3(1, 1, 1), -1);
+    set_camera(&s, (Where){ "", 0 }, v);
+    build_accel(&s, "kd");
+    for (accel = 0; accel < 2; accel++) {
+        int wrong = 0, lit = 0, dark = 0;
+        s.accel = accel ? ACCEL_NONE : ACCEL_KD;
+        for (j = 0; j < W; j++) {
+            for (k = 0; k < SHADOW_SLOTS; k++) wk.blocker[k] = -1;
+            for (i = 0; i < W; i++) {
+                Ray r = camera_ray(&s.cam, W, W, i + 0.5, j + 0.5);
+                Hit h;
+                vec p, to_l, oc, col;
+                double len, b, miss, want;
+                if (!nearest_hit(&s, r, &h, &wk) || h.obj < s.nsph || h.obj - s.nsph > 1) continue;
+                p = comb(-r.o.z / r.d.z, r.d, r.o);          /* exactly on z = 0 */
+                to_l = sub(light, p);
+                len = sqrt(dot(to_l, to_l));
+                to_l = scale(1 / len, to_l);
+                oc = sub(ball, p);
+                b = dot(oc, to_l);                            /* closest approach to the ball */
+                miss = b <= 0 || b >= len ? INFINITY : sqrt(fmax(dot(oc, oc) - b * b, 0)) - 0.5;
+                if (fabs(miss) < 1e-6) continue;              /* on the shadow's edge */
+                want = miss > 0 ? to_l.z : 0;
+                col = trace(&s, r, s.depth, 1, &wk);
+                lit += want > 0, dark += want == 0;
+                wrong += !(fabs(col.x - want) <= 1e-9) || col.y != col.x || col.z != col.x;
+            }
+        }
+        report(wrong == 0 && lit > 1000 && dark > 50,
+               accel ? "a light under the ceiling: the floor exact, lit and in the ball's shadow (loop)"
+                     : "a light under the ceiling: the floor exact, lit and in the ball's shadow (kd-tree)",
+               "%g wrong of %g floor pixels", wrong, lit + dark);
+    }
+    free_scene(&s);
+}
+
 /* ---- scene readers ---- */
 
 static const char *write_tmp(const char *name, const char *text)
@@ -602,17 +676,17 @@ static void test_nff_view(void)
         "pp 3\n0 0 0 0 -1 0\n1 0 0 0 -1 0\n0 0 1 0 -1 0\ns 0 0 0 1\nc 0 0 0 1 0 0 2 0\n");
     Ray a, b;
     double angle;
-    int ok = load_scene(&s, f);
+    if (!load_or_fail(&s, f, "NFF: a scene of every entity loads")) return;
     a = camera_ray(&s.cam, s.w, s.h, 0.5, 24);
     b = camera_ray(&s.cam, s.w, s.h, 63.5, 24);
     angle = acos(dot(a.d, b.d)) * 180 / PI;
-    report(ok && s.w == 64 && s.h == 48 && near(angle, 40, 1e-9),
+    report(s.w == 64 && s.h == 48 && near(angle, 40, 1e-9),
            "NFF angle spans the outer pixel centres", "%.12g deg, want %g", angle, 40);
-    report(ok && s.nlight == 2 && near(s.light[1].color.x, .5 * sqrt(2) / 4, 1e-15)
+    report(s.nlight == 2 && near(s.light[1].color.x, .5 * sqrt(2) / 4, 1e-15)
            && near(s.ambient.x, sqrt(2) / 4, 1e-15),
            "NFF lights: optional colour, strength sqrt(L)/2L", "light %.15g ambient %.15g",
-           s.light[1].color.x, s.ambient.x);
-    report(ok && s.nsph == 1 && s.ncone == 1 && s.ntri == 2 && s.tri[1].n[0] >= 0,
+           s.nlight == 2 ? s.light[1].color.x : NAN, s.ambient.x);
+    report(s.nsph == 1 && s.ncone == 1 && s.ntri == 2 && s.tri[1].n[0] >= 0,
            "NFF p, pp (with normals), s and c", "triangles %g, spheres %g", s.ntri, s.nsph);
     free_scene(&s);
 }
@@ -625,10 +699,9 @@ static void test_obj(void)
         "# a quad and a triangle\nmtllib x.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
         "vn 0 0 1\nvt 0 0\nusemtl red\nf 1//1 2//1 3//1 4//1\nf -4 -3 -1\n");
     const char *sph = write_tmp("mesh.sph", "mesh quad.obj 1 1 1 1 0 0 0 1\n");
-    int ok;
     (void)obj;
-    ok = load_scene(&s, sph);
-    report(ok && s.ntri == 3 && s.nvert == 4 && s.tri[0].n[0] == 0 && s.tri[2].n[0] < 0
+    if (!load_or_fail(&s, sph, "OBJ: a mesh line loads")) return;
+    report(s.ntri == 3 && s.nvert == 4 && s.tri[0].n[0] == 0 && s.tri[2].n[0] < 0
            && s.tri[2].v[2] == 3,
            "OBJ: a quad with normals, negative indices, a mesh line", "triangles %g, vertices %g",
            s.ntri, s.nvert);
@@ -694,7 +767,7 @@ static void test_no_nan(void)
         Worker wk;
         int i, j, W = 48;
         memset(&wk, 0, sizeof wk);
-        if (!load_scene(&s, files[f] ? files[f] : odd)) { bad++; continue; }
+        if (!load_or_fail(&s, files[f] ? files[f] : odd, "no NaN: the scene loads")) { bad++; continue; }
         build_accel(&s, "auto");
         for (j = 0; j < W; j++)
             for (i = 0; i < W; i++) {
@@ -890,6 +963,7 @@ int main(void)
     test_tir();
     test_budget();
     test_float_range();
+    test_light_under_ceiling();
     test_acne();
     return failures != 0;
 }

@@ -271,18 +271,23 @@ static void usage(FILE *f)
 "usage: %s [options] A.ppm B.ppm\n"
 "Compares two PPM images (P3 or P6, in any mix; maxval up to 65535; '-' reads\n"
 "standard input) and prints one line:\n"
-"  channels differing: N of M (P%%), max |diff| D, RMSE R, PSNR S dB\n"
+"  channels differing: N of M (P%%), max |diff| D, RMSE R, PSNR S dB,\n"
+"  mean diff M\n"
 "Differences count in units of the maxval; when the two maxvals differ, both\n"
 "images are first rescaled to the larger one.  PSNR = 20 log10(maxval/RMSE),\n"
-"'inf' for identical images.  Only the first image of a multi-image file is\n"
-"read.\n"
+"'inf' for identical images.  The mean diff is the mean of B - A over every\n"
+"channel, signed: it tells a bias from noise, which max and RMSE cannot (half\n"
+"the channels one level up and half one down, or all of them one down: max 1\n"
+"and RMSE 1 either way, but mean diff 0 and -1).  Only the first image of a\n"
+"multi-image file is read.\n"
 "\n"
 "Options:\n"
 "  -t N, --max N   pass when max |diff| <= N.  The default is 0 (exact\n"
-"                  match), unless --rmse or --psnr is given alone, in which\n"
-"                  case max |diff| is not checked\n"
+"                  match), unless --rmse, --psnr or --bias is given alone,\n"
+"                  in which case max |diff| is not checked\n"
 "  --rmse X        fail when RMSE > X\n"
 "  --psnr DB       fail when PSNR < DB\n"
+"  --bias B        fail when |mean diff| > B\n"
 "  -o DIFF.ppm     write a difference image (P6, maxval 255; '-' is standard\n"
 "                  output, and the summary line then goes to standard error).\n"
 "                  Each channel is 0 where A and B agree, and otherwise\n"
@@ -365,12 +370,13 @@ int main(int argc, char **argv)
 {
     const char *file[2], *diffname = NULL, *v;
     int i, nfile = 0, quiet = 0, endopts = 0, ok, rc;
-    int have_max = 0, have_rmse = 0, have_psnr = 0;
-    double tol_max = 0, tol_rmse = 0, tol_psnr = 0;
+    int have_max = 0, have_rmse = 0, have_psnr = 0, have_bias = 0;
+    double tol_max = 0, tol_rmse = 0, tol_psnr = 0, tol_bias = 0;
     image a, b;
     unsigned top, x, y, d, maxd = 0;
     unsigned long long k, n, ndiff = 0;
-    double sse = 0, rmse, psnr = 0, pct;
+    double sse = 0, rmse, psnr = 0, pct, bias;
+    long long sum = 0;
     char psnrtext[32], pcttext[32];
     FILE *out;
 
@@ -399,6 +405,9 @@ int main(int argc, char **argv)
         } else if ((v = optval(argc, argv, &i, "--psnr"))) {
             tol_psnr = number(v, "--psnr", -1e300);
             have_psnr = 1;
+        } else if ((v = optval(argc, argv, &i, "--bias"))) {
+            tol_bias = number(v, "--bias", 0);
+            have_bias = 1;
         } else if ((v = optval(argc, argv, &i, "-o"))) {
             diffname = v;
         } else {
@@ -414,7 +423,7 @@ int main(int argc, char **argv)
         errmsg("%s: only one image can come from standard input", progname);
         return 2;
     }
-    if (!have_max && (have_rmse || have_psnr)) tol_max = 1e300;
+    if (!have_max && (have_rmse || have_psnr || have_bias)) tol_max = 1e300;
 
     if (!load(file[0], &a)) return 2;
     if (!load(file[1], &b)) {
@@ -438,6 +447,7 @@ int main(int argc, char **argv)
         x = rescale(a.px[k], a.maxval, top);
         y = rescale(b.px[k], b.maxval, top);
         d = x > y ? x - y : y - x;
+        sum += (long long)y - (long long)x;
         if (d) {
             ndiff++;
             if (d > maxd) maxd = d;
@@ -445,6 +455,7 @@ int main(int argc, char **argv)
         }
     }
     rmse = sqrt(sse / (double)n);
+    bias = (double)sum / (double)n;
     if (ndiff) {
         psnr = 20 * log10(top / rmse);
         sprintf(psnrtext, "%.1f", psnr);
@@ -466,8 +477,8 @@ int main(int argc, char **argv)
     out = diffname && strcmp(diffname, "-") == 0 ? stderr : stdout;
     if (!quiet)
         fprintf(out, "channels differing: %llu of %llu (%s%%), max |diff| %u, "
-                "RMSE %.4f, PSNR %s dB\n", ndiff, n, pcttext, maxd, rmse,
-                psnrtext);
+                "RMSE %.4f, PSNR %s dB, mean diff %+.4f\n", ndiff, n, pcttext,
+                maxd, rmse, psnrtext, bias);
 
     rc = 0;
     if (maxd > tol_max) {
@@ -486,6 +497,12 @@ int main(int argc, char **argv)
         if (!quiet)
             errmsg("%s: %s and %s differ: PSNR %.1f dB < %g dB", progname,
                    a.name, b.name, psnr, tol_psnr);
+        rc = 1;
+    }
+    if (have_bias && fabs(bias) > tol_bias) {
+        if (!quiet)
+            errmsg("%s: %s and %s differ: |mean diff| %.4f > %g", progname,
+                   a.name, b.name, fabs(bias), tol_bias);
         rc = 1;
     }
     if (fflush(stdout) != 0) {
