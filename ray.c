@@ -2000,17 +2000,19 @@ static void flatten(const Scene *s, const int *vi, int n, double (*p)[2])
     }
 }
 
-/* Corner k of the polygon idx[0..m-1] can be cut off: it turns left, and no
- * other corner lies in the triangle it makes with its neighbours. */
-static int is_ear(double (*p)[2], const int *idx, int m, int k)
+/* Corner b, between a and c, can be cut off: it turns left, and no corner
+ * lies in the triangle a b c.  Only the corners in bent[0..nbent-1], those
+ * that do not turn left, are looked at: if any corner lies in the triangle,
+ * one of those does (Eberly, "Triangulation by ear clipping", 2002), so the
+ * test takes time in proportion to the dents, not to all the corners. */
+static int is_ear(double (*p)[2], const int *bent, int nbent, int a, int b, int c)
 {
-    const double *a = p[idx[(k + m - 1) % m]], *b = p[idx[k]], *c = p[idx[(k + 1) % m]];
     int j;
-    if (area2(a, b, c) <= 0) return 0;                  /* reflex or flat */
-    for (j = 0; j < m; j++) {
-        const double *q = p[idx[j]];
-        if (inside2(q, a, b, c) && memcmp(q, a, sizeof *p) && memcmp(q, b, sizeof *p)
-            && memcmp(q, c, sizeof *p))
+    if (area2(p[a], p[b], p[c]) <= 0) return 0;         /* reflex or flat */
+    for (j = 0; j < nbent; j++) {
+        const double *q = p[bent[j]];
+        if (inside2(q, p[a], p[b], p[c]) && memcmp(q, p[a], sizeof *p)
+            && memcmp(q, p[b], sizeof *p) && memcmp(q, p[c], sizeof *p))
             return 0;
     }
     return 1;
@@ -2037,32 +2039,66 @@ static void triangulate_arc(Scene *s, const int *vi, const int *ni, int a, int b
     triangulate_arc(s, vi, ni, m, b, mat);
 }
 
+/* Take corner k off the list bent[0..*nbent-1]; pos[k] is its place there,
+ * -1 once it is not listed. */
+static void unlist(int *bent, int *nbent, int *pos, int k)
+{
+    int last = bent[--*nbent];
+    bent[pos[k]] = last, pos[last] = pos[k], pos[k] = -1;
+}
+
+/* Keep corner k listed in bent[] while it does not turn left, between
+ * corners prev[k] and next[k]. */
+static void note_bend(double (*p)[2], const int *prev, const int *next, int k, int *bent,
+                      int *nbent, int *pos)
+{
+    int left = area2(p[prev[k]], p[k], p[next[k]]) > 0;
+    if (!left && pos[k] < 0) pos[k] = *nbent, bent[(*nbent)++] = k;
+    if (left && pos[k] >= 0) unlist(bent, nbent, pos, k);
+}
+
 /* A planar polygon, convex or not, as triangles, by ear clipping (Meisters,
  * "Polygons have ears", 1975): some corner can always be cut off, leaving a
  * polygon one corner smaller.  A fan from one corner would be wrong for the
  * gears' concave 144-gons; a convex polygon takes the O(n) way above.
+ * The ears are sought going round the polygon, and after each cut the
+ * search goes on two corners further, not at the next one: trying the next
+ * corner first would cut ears a, c, d then a, d, e and so on, a fan at a
+ * (one dent in an 8000-gon put all 7998 triangles at one corner, and the
+ * kd-tree took 10 s to build).  Going round, each lap cuts every other
+ * corner, as triangulate_arc halves an arc, so a corner ends up in a few
+ * triangles per lap and about log2 n laps.  A polygon whose only
+ * triangulation is a fan (every corner but one a dent, facing it) still
+ * gives one; the kd-tree copes with that too.
  * vi and ni are the corners' vertex and normal indices (ni may be NULL). */
 static void triangulate(Scene *s, const int *vi, const int *ni, int n, int mat)
 {
     double (*p)[2] = malloc((size_t)n * sizeof *p);
-    int *idx = malloc((size_t)n * sizeof *idx), m = n, k, convex = 1;
-    if (!p || !idx) out_of_memory();
+    int *next = malloc((size_t)n * sizeof *next), *prev = malloc((size_t)n * sizeof *prev);
+    int *bent = malloc((size_t)n * sizeof *bent), *pos = malloc((size_t)n * sizeof *pos);
+    int m = n, k, nbent = 0, convex = 1;
+    if (!p || !next || !prev || !bent || !pos) out_of_memory();
     flatten(s, vi, n, p);
+    for (k = 0; k < n; k++) next[k] = (k + 1) % n, prev[k] = (k + n - 1) % n, pos[k] = -1;
     for (k = 0; k < n; k++) {
-        idx[k] = k;
-        if (area2(p[(k + n - 1) % n], p[k], p[(k + 1) % n]) < 0) convex = 0;
+        if (area2(p[prev[k]], p[k], p[next[k]]) < 0) convex = 0;
+        note_bend(p, prev, next, k, bent, &nbent, pos);
     }
     if (convex) triangulate_arc(s, vi, ni, 0, n - 1, mat);
     for (k = 0; !convex && m > 2; m--) {
-        int tries;
-        for (tries = 0; m > 3 && tries < m && !is_ear(p, idx, m, k); tries++) k = (k + 1) % m;
+        int tries, a, c;
+        for (tries = 0; m > 3 && tries < m && !is_ear(p, bent, nbent, prev[k], k, next[k]); tries++)
+            k = next[k];
         /* tries == m: only flat or self-touching corners are left; cut one anyway */
-        add_corner_triangle(s, vi, ni, idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m], mat);
-        memmove(idx + k, idx + k + 1, (size_t)(m - k - 1) * sizeof *idx);
-        if (k >= m - 1) k = 0;
+        a = prev[k], c = next[k];
+        add_corner_triangle(s, vi, ni, a, k, c, mat);
+        next[a] = c, prev[c] = a;
+        if (pos[k] >= 0) unlist(bent, &nbent, pos, k);  /* cut anyway */
+        note_bend(p, prev, next, a, bent, &nbent, pos);
+        note_bend(p, prev, next, c, bent, &nbent, pos);
+        k = next[c];
     }
-    free(p);
-    free(idx);
+    free(p), free(next), free(prev), free(bent), free(pos);
 }
 
 static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
