@@ -99,6 +99,8 @@
 #endif
 #include "prims.h"
 #include "kdtree.h"
+#include "bvh.h"
+#include "grid.h"
 #ifdef _OPENMP
 #include <omp.h>
 #define OMP(directive) _Pragma(#directive)
@@ -166,13 +168,18 @@ typedef struct {
     int w, h, depth;
     vec ambient, background;
     int cull;                 /* for triangles still to come: `sided 1` */
-    int accel;                /* which structure finds hits: ACCEL_NONE or ACCEL_KD */
+    int accel;                /* which structure finds hits: an ACCEL_ below */
+    const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
     kd_tree *kd;              /* the kd-tree, when accel is ACCEL_KD */
+    bvh *bvh;                 /* the BVH, when accel is ACCEL_BVH */
+    grid *grid;               /* the grid, when accel is ACCEL_GRID */
     prims prims;              /* how the structure sees the objects (prims.h) */
 } Scene;
 
-/* --accel none: every ray tests every object; kd: the kd-tree of kdtree.c. */
-enum { ACCEL_NONE, ACCEL_KD };
+/* --accel none: every ray tests every object; kd: the kd-tree of kdtree.c;
+ * bvh: the bounding volume hierarchy of bvh.c; grid: the uniform grid of
+ * grid.c. */
+enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
 
 /* Objects are numbered spheres first, then cones, then triangles. */
 enum { SPHERE, CONE, TRIANGLE };
@@ -509,12 +516,17 @@ static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk)
 {
     real ti;
     int i, best = -1;
-    if (s->accel == ACCEL_KD) {
+    if (s->accel != ACCEL_NONE) {
         double o[3], d[3], tmax = INFINITY;
         prim_counters c = { 0, 0, 0 };
         to3(q->r.o, o);
         to3(q->r.d, d);
-        best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, 0, &tmax, &c);
+        if (s->accel == ACCEL_KD)
+            best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, 0, &tmax, &c);
+        else if (s->accel == ACCEL_BVH)
+            best = bvh_nearest(s->bvh, &s->prims, o, d, q, q->r.skip, 0, &tmax, &c);
+        else
+            best = grid_nearest(s->grid, &s->prims, o, d, q, q->r.skip, 0, &tmax, &c);
         *t = (real)tmax;
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
@@ -641,13 +653,18 @@ static int find_any(const Scene *s, Query *q, real tmax, Worker *wk)
 {
     real t;
     int i;
-    if (s->accel == ACCEL_KD) {
+    if (s->accel != ACCEL_NONE) {
         double o[3], d[3];
         prim_counters c = { 0, 0, 0 };
         int hit;
         to3(q->r.o, o);
         to3(q->r.d, d);
-        hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, 0, tmax, &c);
+        if (s->accel == ACCEL_KD)
+            hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, 0, tmax, &c);
+        else if (s->accel == ACCEL_BVH)
+            hit = bvh_any(s->bvh, &s->prims, o, d, q, q->r.skip, 0, tmax, &c);
+        else
+            hit = grid_any(s->grid, &s->prims, o, d, q, q->r.skip, 0, tmax, &c);
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
         return hit;
@@ -1517,12 +1534,29 @@ static char *beside(const char *scene, const char *name)
     return p;
 }
 
+/* The structures --accel and a scene's `accel` line name (see build_accel):
+ * the name as a string that lasts, or NULL for an unknown one. */
+static const char *accel_name(const char *name)
+{
+    static const char *const names[] = { "kd", "bvh", "grid", "none", "auto" };
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (!strcmp(name, names[i])) return names[i];
+    return NULL;
+}
+
 /* A keyword line: ray.c's extensions to minray's format. */
 static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
 {
     real v[17];
     const char *k = tok[0];
     int mat, ok;
+    if (!strcmp(k, "accel")) {
+        if (ntok != 2 || !accel_name(tok[1]))
+            return fail(w, "expected `accel` and one of kd, bvh, grid, none, auto", NULL);
+        s->accel_line = accel_name(tok[1]);
+        return 1;
+    }
     if (!strcmp(k, "size"))
         return numbers(w, k, tok, ntok, 1, 2, v)
                && (check_size(v[0], v[1], &s->w, &s->h) || fail(w, SIZE_RULE, NULL));
@@ -1889,8 +1923,9 @@ static void usage(FILE *to)
           "  -d N       recursion depth, 1 = primary rays only (default: scene's, else 5)\n"
           "  -t N       threads (default: all cores, when built with OpenMP)\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
-          "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
-          "             the tree from 8 objects up)\n"
+          "  --accel A  kd (the kd-tree), bvh (bounding volume hierarchy), grid\n"
+          "             (uniform grid), none (test every object) or auto (default:\n"
+          "             the scene's `accel` line, else the kd-tree from 8 objects up)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
           "  --help     this text\n", to);
 }
@@ -1928,8 +1963,8 @@ static char *default_output(const char *scene)
 #define TREE_FROM 8
 
 /* The structure that answers nearest_hit and any_hit, as --accel says: the
- * kd-tree, none (every ray tests every object), or auto (the tree once the
- * scene has TREE_FROM objects). */
+ * kd-tree, the BVH (its SAH build), the grid, none (every ray tests every
+ * object), or auto (the kd-tree once the scene has TREE_FROM objects). */
 static int build_accel(Scene *s, const char *accel)
 {
     s->prims.bounds = prim_bounds;
@@ -1938,9 +1973,20 @@ static int build_accel(Scene *s, const char *accel)
     s->prims.user = s;
     s->accel = ACCEL_NONE;
     if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
-    s->kd = kd_build(nobj(s), &s->prims);
-    if (!s->kd) { fprintf(stderr, "ray: out of memory for the kd-tree\n"); return 0; }
-    s->accel = ACCEL_KD;
+    if (!strcmp(accel, "bvh")) {
+        s->accel = ACCEL_BVH;
+        s->bvh = bvh_build(nobj(s), &s->prims, BVH_SAH);
+    } else if (!strcmp(accel, "grid")) {
+        s->accel = ACCEL_GRID;
+        s->grid = grid_build(nobj(s), &s->prims);
+    } else {
+        s->accel = ACCEL_KD;
+        s->kd = kd_build(nobj(s), &s->prims);
+    }
+    if (!s->kd && !s->bvh && !s->grid) {
+        fprintf(stderr, "ray: out of memory for the acceleration structure\n");
+        return 0;
+    }
     return 1;
 }
 
@@ -1960,8 +2006,22 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
                 "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
                 k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf,
                 k.bytes / 1e6, k.sah_cost, build);
+    } else if (s->accel == ACCEL_BVH) {
+        bvh_info b;
+        bvh_describe(s->bvh, &b);
+        fprintf(stderr, "bvh        %ld nodes, %ld leaves, depth %ld, %.2f objects per leaf,\n"
+                "           %lu bytes, SAH cost %.2f, built in %.3f s\n",
+                b.nodes, b.leaves, b.max_depth, b.prims_per_leaf, (unsigned long)b.bytes,
+                b.sah_cost, build);
+    } else if (s->accel == ACCEL_GRID) {
+        grid_info g;
+        grid_describe(s->grid, &g);
+        fprintf(stderr, "grid       %dx%dx%d cells (%ld empty), %.2f references per object,\n"
+                "           %lu bytes, built in %.3f s\n", g.res[0], g.res[1], g.res[2],
+                g.empty_cells, nobj(s) ? (double)g.prim_refs / nobj(s) : 0.0,
+                (unsigned long)g.bytes, build);
     } else
-        fprintf(stderr, "kd-tree    none: every ray tests every object\n");
+        fprintf(stderr, "accel      none: every ray tests every object\n");
     fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
             rays, st->primary, st->shadow, st->reflected, st->refracted);
     fprintf(stderr, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
@@ -1976,6 +2036,8 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
 static void free_scene(Scene *s)
 {
     if (s->kd) kd_free(s->kd);
+    if (s->bvh) bvh_free(s->bvh);
+    if (s->grid) grid_free(s->grid);
     free(s->mat); free(s->sph); free(s->cone); free(s->tri);
     free(s->vert); free(s->norm); free(s->light);
 }
@@ -2002,7 +2064,7 @@ int main(int argc, char **argv)
     Options o = { 1, 0, 0 };
     Counts st;
     Output out;
-    const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
+    const char *scene = NULL, *size = NULL, *accel = NULL, *name = NULL;
     char *auto_name = NULL;
     int i, depth = 0, plain = 0, stats = 0, ok;
     unsigned char *img;
@@ -2018,8 +2080,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "-t")) { o.threads = int_arg(a, next, 4096); i++; }
         else if (!strcmp(a, "--p3")) plain = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
-        else if (!strcmp(a, "--accel") && next
-                 && (!strcmp(next, "kd") || !strcmp(next, "none") || !strcmp(next, "auto")))
+        else if (!strcmp(a, "--accel") && next && accel_name(next))
             accel = argv[++i];
         else if (a[0] == '-' && a[1]) {
             fprintf(stderr, "ray: unknown option, or a bad or missing value: %s\n", a);
@@ -2037,6 +2098,7 @@ int main(int argc, char **argv)
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
     if (depth) s.depth = depth;
+    if (!accel) accel = s.accel_line ? s.accel_line : "auto";
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;

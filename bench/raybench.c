@@ -1,6 +1,6 @@
 /* raybench.c - the kd-tree's build and traversal, measured on ray.c's own code.
  *
- *     cc -O2 -o raybench bench/raybench.c kdtree.c -lm      (no -fopenmp: one thread)
+ *     cc -O2 -o raybench bench/raybench.c kdtree.c bvh.c grid.c -lm     (no -fopenmp: one thread)
  *
  *     raybench build [MAXN]          build time against N on cube-spheres of 10k
  *                                    up to MAXN (default 1M) triangles, and the

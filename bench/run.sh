@@ -108,9 +108,12 @@ status=0   # 1 once a section of ours (not an instrument) failed
 # ./ray is stale.  OpenMP is detected as the Makefile does.
 OMP=$(echo 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
 RAYSRC=(ray.c)
-# kdtree.c is linked once ray.c uses it, not merely because it exists: a
-# half-written tree must not break the bench of a renderer that ignores it.
-if grep -q '^#include "kdtree.h"' ray.c && [ -f kdtree.c ]; then RAYSRC+=(kdtree.c); fi
+# Each acceleration module is linked once ray.c uses it, not merely because
+# it exists: a half-written one must not break the bench of a renderer that
+# ignores it.
+for m in kdtree bvh grid; do
+  if grep -q "^#include \"$m.h\"" ray.c && [ -f $m.c ]; then RAYSRC+=($m.c); fi
+done
 
 build() {  # build OUTPUT CC-ARGS...
   local out=$1; shift
@@ -137,7 +140,7 @@ build "$OUT/svgplot" bench/svgplot.c
 RAYBENCH=$OUT/raybench
 # $CFLAGS is split into words on purpose, as make does.
 # shellcheck disable=SC2086
-if ! $CC $CFLAGS -o "$RAYBENCH" bench/raybench.c kdtree.c -lm 2>"$OUT/raybench-build.log"; then
+if ! $CC $CFLAGS -o "$RAYBENCH" bench/raybench.c "${RAYSRC[@]:1}" -lm 2>"$OUT/raybench-build.log"; then
   cat "$OUT/raybench-build.log" >&2
   say "bench/raybench.c does not build: the build and rays sections will be skipped"
   RAYBENCH=
