@@ -45,12 +45,15 @@ enum { BVH_SAH, BVH_MEDIAN };
 
 /* Shape of a built hierarchy, for --stats. */
 typedef struct {
-    long nodes, leaves, max_depth, prim_refs;
+    long nodes, leaves, max_depth, prim_refs;   /* four-way nodes */
     double prims_per_leaf;  /* mean over leaves */
     size_t bytes;           /* nodes plus the primitive-index list */
     const void *block;      /* they, as one block of bytes (for tests: two
                                builds of the same input give equal blocks) */
-    double sah_cost;        /* expected cost of a random ray, SAH model */
+    double sah_cost;        /* expected cost of a random ray, SAH model, of the
+                               four-way tree (of the binary one it came from:
+                               sah_cost_binary) */
+    double sah_cost_binary;
     double build_seconds;   /* processor time */
 } bvh_info;
 
