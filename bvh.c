@@ -156,32 +156,6 @@ typedef struct {
     float entry;
 } bvh_todo;
 
-/* Intersect_P(ray, box) for the four children of a node at once: the slab
- * test (Kay & Kajiya 1986) of each box grown by delta, between tmin and
- * tmax.  Returns a bit per child whose box the ray enters, the t where it
- * enters in at[].  Written so that NaN never excludes. */
-static inline unsigned enter(const bvh_node4 *nd, const bvh_ray *r, float tmax,
-                             float at[4])
-{
-    const float *nx = nd->box[r->neg[0]][0], *fx = nd->box[1 - r->neg[0]][0];
-    const float *ny = nd->box[r->neg[1]][1], *fy = nd->box[1 - r->neg[1]][1];
-    const float *nz = nd->box[r->neg[2]][2], *fz = nd->box[1 - r->neg[2]][2];
-    float t0[4], t1[4];
-    int k;
-    for (k = 0; k < 4; k++) {
-        float ax = (nx[k] - r->on[0]) * r->inv[0], bx = (fx[k] - r->of[0]) * r->inv[0];
-        float ay = (ny[k] - r->on[1]) * r->inv[1], by = (fy[k] - r->of[1]) * r->inv[1];
-        float az = (nz[k] - r->on[2]) * r->inv[2], bz = (fz[k] - r->of[2]) * r->inv[2];
-        float lo = r->tmin, hi = tmax;
-        lo = ax > lo ? ax : lo, lo = ay > lo ? ay : lo, lo = az > lo ? az : lo;
-        hi = bx < hi ? bx : hi, hi = by < hi ? by : hi, hi = bz < hi ? bz : hi;
-        t0[k] = lo, t1[k] = hi;
-    }
-    for (k = 0; k < 4; k++) at[k] = t0[k];
-    return (unsigned)(t0[0] <= t1[0]) | (unsigned)(t0[1] <= t1[1]) << 1
-           | (unsigned)(t0[2] <= t1[2]) << 2 | (unsigned)(t0[3] <= t1[3]) << 3;
-}
-
 /* The ray set up for the float slab test: 1, or 0 when its numbers leave
  * the test's range (see BVH_EPS), or -1 for NaN or infinite input. */
 static int setup_ray(const bvh *t, const double org[3], const double dir[3],
@@ -233,20 +207,41 @@ static inline int test_leaf(const bvh *t, uint32_t first, uint32_t count, const 
     return best;
 }
 
-/* The children of node nd that the ray enters before tmax, nearer first
- * (on equal entries, the earlier lane first): returns how many, 0 to 4.
- * An empty lane's inside-out box is never entered. */
+/* Intersect_P(ray, box) for the four children of node nd at once: the
+ * slab test (Kay & Kajiya 1986) of each box grown by delta, between tmin
+ * and tmax, written so that NaN never excludes and so that the compiler
+ * can run the four lanes as one vector operation per line.  The children
+ * the ray enters go to out[], nearer first (on equal entries, the earlier
+ * lane first), with the t where it enters; returns how many, 0 to 4.  An
+ * empty lane's inside-out box is never entered. */
 static inline int children(const bvh_node4 *nd, const bvh_ray *r, float tmax,
                            bvh_todo out[4])
 {
-    float at[4];
-    unsigned mask = enter(nd, r, tmax, at);
-    int n = 0, k, j;
+    const float *nx = nd->box[r->neg[0]][0], *fx = nd->box[1 - r->neg[0]][0];
+    const float *ny = nd->box[r->neg[1]][1], *fy = nd->box[1 - r->neg[1]][1];
+    const float *nz = nd->box[r->neg[2]][2], *fz = nd->box[1 - r->neg[2]][2];
+    float t0[4], t1[4];
+    unsigned mask;
+    int k, j, n = 0;
+    for (k = 0; k < 4; k++) {
+        float ax = (nx[k] - r->on[0]) * r->inv[0], bx = (fx[k] - r->of[0]) * r->inv[0];
+        float ay = (ny[k] - r->on[1]) * r->inv[1], by = (fy[k] - r->of[1]) * r->inv[1];
+        float az = (nz[k] - r->on[2]) * r->inv[2], bz = (fz[k] - r->of[2]) * r->inv[2];
+        float lo = r->tmin, hi = tmax;
+        lo = ax > lo ? ax : lo, lo = ay > lo ? ay : lo, lo = az > lo ? az : lo;
+        hi = bx < hi ? bx : hi, hi = by < hi ? by : hi, hi = bz < hi ? bz : hi;
+        t0[k] = lo, t1[k] = hi;
+    }
+    mask = (unsigned)(t0[0] <= t1[0]) | (unsigned)(t0[1] <= t1[1]) << 1
+           | (unsigned)(t0[2] <= t1[2]) << 2 | (unsigned)(t0[3] <= t1[3]) << 3;
     for (k = 0; mask; k++, mask >>= 1) {
         if (!(mask & 1)) continue;
-        for (j = n; j > 0 && at[k] < out[j - 1].entry; j--) out[j] = out[j - 1];
-        out[j].index = nd->index[k], out[j].count = nd->count[k], out[j].entry = at[k];
-        n++;
+        j = n++;
+        if (j > 0 && t0[k] < out[j - 1].entry) {   /* insertion sort, rarely past one */
+            do out[j] = out[j - 1];
+            while (--j > 0 && t0[k] < out[j - 1].entry);
+        }
+        out[j].index = nd->index[k], out[j].count = nd->count[k], out[j].entry = t0[k];
     }
     return n;
 }
@@ -426,81 +421,113 @@ static void node_to_box(const bvh_node *nd, bvh_box *b)
 
 /* ---- the builder -------------------------------------------------------- */
 
+/* A primitive as the build moves it: its box and its number, 32 bytes.
+ * The build reorders these records themselves, not indices to them, so
+ * that every pass over a node's primitives reads memory in order (Wald
+ * 2007 does the same).  Centroids are used doubled, lo + hi, which orders
+ * and bins them alike without a multiplication. */
+typedef struct {
+    float lo[3];
+    int id;
+    float hi[3];
+    float pad;
+} bvh_ref;
+
 typedef struct {
     const prims *p;
     int method;
-    bvh_box *box;      /* per primitive */
-    float (*cen)[3];   /* per primitive: its box's centre */
-    int *idx;          /* the primitives being sorted into leaves */
+    bvh_ref *ref;
     bvh_node *nodes;
     long nnodes;
     long max_depth, leaves;
 } bvh_builder;
 
-typedef struct {
-    bvh_box box;
-    long count;
-} bvh_bin;
+static float centroid2(const bvh_ref *r, int a) { return r->lo[a] + r->hi[a]; }
 
-/* The node's box and the box of its primitives' centroids. */
+static void grow_ref(bvh_box *box, bvh_box *cbox, const bvh_ref *r)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        float c = centroid2(r, a);
+        box->lo[a] = r->lo[a] < box->lo[a] ? r->lo[a] : box->lo[a];
+        box->hi[a] = r->hi[a] > box->hi[a] ? r->hi[a] : box->hi[a];
+        cbox->lo[a] = c < cbox->lo[a] ? c : cbox->lo[a];
+        cbox->hi[a] = c > cbox->hi[a] ? c : cbox->hi[a];
+    }
+}
+
+/* The box of primitives first..first+n-1, and the box of their doubled
+ * centroids. */
 static void bounds_of(const bvh_builder *b, long first, long n, bvh_box *box,
                       bvh_box *cbox)
 {
     long k;
-    int a;
     box_empty(box), box_empty(cbox);
-    for (k = first; k < first + n; k++) {
-        const float *c = b->cen[b->idx[k]];
-        box_grow(box, &b->box[b->idx[k]]);
-        for (a = 0; a < 3; a++) {
-            if (c[a] < cbox->lo[a]) cbox->lo[a] = c[a];
-            if (c[a] > cbox->hi[a]) cbox->hi[a] = c[a];
-        }
-    }
+    for (k = first; k < first + n; k++) grow_ref(box, cbox, &b->ref[k]);
 }
 
-static int bin_of(float c, float lo, double k1)
+/* A node of n primitives gets BINS bins per axis, or n when fewer: a
+ * small node's sweep then costs in proportion to it. */
+static int bins_for(long n) { return n < BINS ? (int)n : BINS; }
+
+static int bin_of(float c, float lo, float k1, int nb)
 {
     int i = (int)((c - lo) * k1);
-    return i < 0 ? 0 : i >= BINS ? BINS - 1 : i;
+    return i < 0 ? 0 : i >= nb ? nb - 1 : i;
 }
 
-/* Wald 2007: the best plane between bins on any axis.  Returns its cost,
- * and the axis and the number of bins left of it; HUGE_VAL when no plane
- * parts the primitives (all centroids in one bin on every axis). */
+/* nb slabs per axis of the centroid box: 1/width, or 0 for a flat axis
+ * (everything in bin 0). */
+static float bin_scale(const bvh_box *cbox, int a, int nb)
+{
+    double ext = (double)cbox->hi[a] - cbox->lo[a];
+    return ext > 0 ? (float)(nb * (1 - 1e-6) / ext) : 0;
+}
+
+/* Wald 2007: one pass puts every primitive in a bin on each axis; then a
+ * sweep from each end prices the planes between bins.  Returns the
+ * best cost, its axis and the number of bins left of it; HUGE_VAL when no
+ * plane parts the primitives. */
 static double best_bin_split(const bvh_builder *b, long first, long n,
                              const bvh_box *cbox, double area, int *axis,
                              int *split)
 {
+    bvh_box bin[3][BINS], acc;
+    long count[3][BINS], k;
+    float k1[3];
     double best = HUGE_VAL;
-    int a, i;
+    int a, i, nb = bins_for(n);
     for (a = 0; a < 3; a++) {
-        bvh_bin bin[BINS];
-        double right_area[BINS];
-        long right_n[BINS], k, nl = 0;
-        float lo = cbox->lo[a];
-        double ext = (double)cbox->hi[a] - lo, k1;
-        bvh_box acc;
-        if (!(ext > 0)) continue;
-        k1 = BINS * (1 - 1e-6) / ext;
-        for (i = 0; i < BINS; i++) box_empty(&bin[i].box), bin[i].count = 0;
-        for (k = first; k < first + n; k++) {
-            int prim = b->idx[k], j = bin_of(b->cen[prim][a], lo, k1);
-            box_grow(&bin[j].box, &b->box[prim]);
-            bin[j].count++;
+        k1[a] = bin_scale(cbox, a, nb);
+        for (i = 0; i < nb; i++) box_empty(&bin[a][i]), count[a][i] = 0;
+    }
+    for (k = first; k < first + n; k++) {
+        const bvh_ref *r = &b->ref[k];
+        for (a = 0; a < 3; a++) {
+            int j = bin_of(centroid2(r, a), cbox->lo[a], k1[a], nb), c;
+            bvh_box *x = &bin[a][j];
+            for (c = 0; c < 3; c++) {   /* min and max without a branch */
+                x->lo[c] = r->lo[c] < x->lo[c] ? r->lo[c] : x->lo[c];
+                x->hi[c] = r->hi[c] > x->hi[c] ? r->hi[c] : x->hi[c];
+            }
+            count[a][j]++;
         }
+    }
+    for (a = 0; a < 3; a++) {
+        double right_area[BINS];
+        long right_n[BINS], nl = 0;
+        if (k1[a] == 0) continue;
         box_empty(&acc);
-        right_n[BINS - 1] = 0;
-        for (i = BINS - 1, k = 0; i > 0; i--) {   /* right of plane i: bins i.. */
-            box_grow(&acc, &bin[i].box);
-            k += bin[i].count;
+        for (i = nb - 1, k = 0; i > 0; i--) {     /* right of plane i: bins i.. */
+            box_grow(&acc, &bin[a][i]);
+            k += count[a][i];
             right_area[i] = box_area(&acc), right_n[i] = k;
         }
         box_empty(&acc);
-        for (i = 1; i < BINS; i++) {              /* plane i: bins 0..i-1 left */
+        for (i = 1; i < nb; i++) {                /* plane i: bins 0..i-1 left */
             double cost;
-            box_grow(&acc, &bin[i - 1].box);
-            nl += bin[i - 1].count;
+            box_grow(&acc, &bin[a][i - 1]);
+            nl += count[a][i - 1];
             if (nl == 0 || right_n[i] == 0) continue;
             cost = COST_STEP + COST_TEST * (box_area(&acc) * nl + right_area[i] * right_n[i]) / area;
             if (cost < best) best = cost, *axis = a, *split = i;
@@ -509,19 +536,30 @@ static double best_bin_split(const bvh_builder *b, long first, long n,
     return best;
 }
 
-/* Reorders idx[first..first+n) so that those left of the plane come first;
- * returns how many they are. */
+/* The two sides of a split: their boxes and centroid boxes. */
+typedef struct {
+    bvh_box box[2], cbox[2];
+} bvh_sides;
+
+/* Reorders the node's primitives so that those left of the plane come
+ * first, noting each side's boxes on the way; returns how many go left. */
 static long partition_bins(bvh_builder *b, long first, long n, const bvh_box *cbox,
-                           int axis, int split)
+                           int axis, int split, bvh_sides *sd)
 {
-    float lo = cbox->lo[axis];
-    double k1 = BINS * (1 - 1e-6) / ((double)cbox->hi[axis] - lo);
+    int nb = bins_for(n);
+    float lo = cbox->lo[axis], k1 = bin_scale(cbox, axis, nb);
     long i = first, j = first + n - 1;
+    box_empty(&sd->box[0]), box_empty(&sd->cbox[0]);
+    box_empty(&sd->box[1]), box_empty(&sd->cbox[1]);
     while (i <= j) {
-        if (bin_of(b->cen[b->idx[i]][axis], lo, k1) < split) i++;
-        else {
-            int tmp = b->idx[i];
-            b->idx[i] = b->idx[j], b->idx[j] = tmp;
+        bvh_ref *r = &b->ref[i];
+        if (bin_of(centroid2(r, axis), lo, k1, nb) < split) {
+            grow_ref(&sd->box[0], &sd->cbox[0], r);
+            i++;
+        } else {
+            bvh_ref tmp = *r;
+            *r = b->ref[j], b->ref[j] = tmp;
+            grow_ref(&sd->box[1], &sd->cbox[1], &b->ref[j]);
             j--;
         }
     }
@@ -530,27 +568,32 @@ static long partition_bins(bvh_builder *b, long first, long n, const bvh_box *cb
 
 /* Centroid order along an axis, ties by primitive number: a total order, so
  * the median build is deterministic. */
-static int before(const bvh_builder *b, int p, int q, int axis)
+static int before(const bvh_ref *p, const bvh_ref *q, int axis)
 {
-    float cp = b->cen[p][axis], cq = b->cen[q][axis];
-    return cp < cq || (cp == cq && p < q);
+    float cp = centroid2(p, axis), cq = centroid2(q, axis);
+    return cp < cq || (cp == cq && p->id < q->id);
 }
 
-/* Hoare's selection (quickselect): idx[first..first+n) reordered so that
+static void swap_refs(bvh_ref *x, long i, long j)
+{
+    bvh_ref tmp = x[i];
+    x[i] = x[j], x[j] = tmp;
+}
+
+/* Hoare's selection (quickselect): the node's primitives reordered so that
  * the m-th smallest is at first + m, smaller ones before it and larger
  * after; expected O(n).  The pivot is the middle element, swapped to the
  * end (Lomuto's partition). */
 static void select_nth(bvh_builder *b, long first, long n, long m, int axis)
 {
     long lo = first, hi = first + n - 1, want = first + m;
-    int *x = b->idx;
+    bvh_ref *x = b->ref;
     while (lo < hi) {
-        long mid = lo + (hi - lo) / 2, k, store = lo;
-        int pivot = x[mid], tmp;
-        x[mid] = x[hi], x[hi] = pivot;
+        long k, store = lo;
+        swap_refs(x, lo + (hi - lo) / 2, hi);
         for (k = lo; k < hi; k++)
-            if (before(b, x[k], pivot, axis)) tmp = x[k], x[k] = x[store], x[store++] = tmp;
-        x[hi] = x[store], x[store] = pivot;
+            if (before(&x[k], &x[hi], axis)) swap_refs(x, k, store++);
+        swap_refs(x, hi, store);
         if (store == want) return;
         if (store < want) lo = store + 1;
         else hi = store - 1;
@@ -564,9 +607,20 @@ static int longest_axis(const bvh_box *b)
     return dx >= dy ? (dx >= dz ? 0 : 2) : (dy >= dz ? 1 : 2);
 }
 
-/* How many primitives of the node go left, 0 for a leaf. */
+/* Half the primitives each side, by centroid along the axis; the sides'
+ * boxes measured afresh. */
+static long split_median(bvh_builder *b, long first, long n, int axis, bvh_sides *sd)
+{
+    select_nth(b, first, n, n / 2, axis);
+    bounds_of(b, first, n / 2, &sd->box[0], &sd->cbox[0]);
+    bounds_of(b, first + n / 2, n - n / 2, &sd->box[1], &sd->cbox[1]);
+    return n / 2;
+}
+
+/* How many primitives of the node go left (and the sides' boxes in sd);
+ * 0 for a leaf. */
 static long choose_split(bvh_builder *b, long first, long n, int depth,
-                         const bvh_box *box, const bvh_box *cbox)
+                         const bvh_box *box, const bvh_box *cbox, bvh_sides *sd)
 {
     int axis = longest_axis(cbox), split = 0;
     double cost;
@@ -574,26 +628,24 @@ static long choose_split(bvh_builder *b, long first, long n, int depth,
         return 0;   /* one primitive, or every centroid at one point */
     if (b->method == BVH_MEDIAN || depth >= SAH_DEPTH) {
         if (b->method == BVH_MEDIAN && n <= MEDIAN_LEAF) return 0;
-        select_nth(b, first, n, n / 2, axis);
-        return n / 2;
+        return split_median(b, first, n, axis, sd);
     }
     cost = best_bin_split(b, first, n, cbox, box_area(box), &axis, &split);
-    if (cost == HUGE_VAL) {   /* all in one bin: fall back to the median */
-        select_nth(b, first, n, n / 2, axis);
-        return n / 2;
-    }
+    if (cost == HUGE_VAL) return split_median(b, first, n, axis, sd);  /* all in one bin */
     if (cost >= COST_TEST * n && n <= MAX_LEAF) return 0;
-    return partition_bins(b, first, n, cbox, axis, split);
+    return partition_bins(b, first, n, cbox, axis, split, sd);
 }
 
-static void build_node(bvh_builder *b, long at, long first, long n, int depth)
+/* Node `at` over primitives first..first+n-1, whose boxes are box and
+ * (centroids) cbox. */
+static void build_node(bvh_builder *b, long at, long first, long n, int depth,
+                       const bvh_box *box, const bvh_box *cbox)
 {
-    bvh_box box, cbox;
+    bvh_sides sd;
     long nl;
-    bounds_of(b, first, n, &box, &cbox);
-    node_box(&b->nodes[at], &box);
+    node_box(&b->nodes[at], box);
     if (depth > b->max_depth) b->max_depth = depth;
-    nl = choose_split(b, first, n, depth, &box, &cbox);
+    nl = choose_split(b, first, n, depth, box, cbox, &sd);
     if (nl == 0) {
         b->nodes[at].index = (uint32_t)first, b->nodes[at].count = (uint32_t)n;
         b->leaves++;
@@ -601,8 +653,8 @@ static void build_node(bvh_builder *b, long at, long first, long n, int depth)
     }
     b->nodes[at].index = (uint32_t)b->nnodes, b->nodes[at].count = 0;
     b->nnodes += 2;
-    build_node(b, b->nodes[at].index, first, nl, depth + 1);
-    build_node(b, b->nodes[at].index + 1, first + nl, n - nl, depth + 1);
+    build_node(b, b->nodes[at].index, first, nl, depth + 1, &sd.box[0], &sd.cbox[0]);
+    build_node(b, b->nodes[at].index + 1, first + nl, n - nl, depth + 1, &sd.box[1], &sd.cbox[1]);
 }
 
 /* Expected cost of a ray that meets the root of the binary tree, by the SAH
@@ -751,7 +803,7 @@ static bvh *alloc_tree(long nnodes, long nprims)
 
 /* The binary tree collapsed to four-way nodes: at most one per binary
  * inner node, or one for a root that is a leaf. */
-static bvh *finish(bvh_builder *b, long nprims)
+static bvh *finish(bvh_builder *b, const int *ids, long nprims)
 {
     long inner = b->nnodes ? (b->nnodes - 1 - b->leaves) : 0, used = 0, depth = 0;
     bvh *t = alloc_tree(b->nnodes ? (inner > 0 ? inner : 1) : 0, nprims);
@@ -759,7 +811,7 @@ static bvh *finish(bvh_builder *b, long nprims)
     if (b->nnodes) collapse(b->nodes, 0, t->nodes, &used, 0, &depth);
     t->nnodes = used;
     t->bytes = (size_t)used * sizeof(bvh_node4) + (size_t)nprims * sizeof(int);
-    if (nprims) memmove(t->nodes + used, b->idx, (size_t)nprims * sizeof(int));
+    if (nprims) memcpy(t->nodes + used, ids, (size_t)nprims * sizeof(int));
     t->prims = (int *)(t->nodes + used);
     set_scale(t);
     t->info.nodes = used;
@@ -773,17 +825,18 @@ static bvh *finish(bvh_builder *b, long nprims)
     return t;
 }
 
-/* Boxes and centroids of every primitive; the ones with a box go to idx.
- * Returns how many. */
+/* A record for every primitive with a box; returns how many. */
 static long gather(bvh_builder *b, int n)
 {
     long m = 0;
-    int i, a;
+    int i;
     for (i = 0; i < n; i++) {
-        if (!prim_box(b->p, i, &b->box[i])) continue;
-        for (a = 0; a < 3; a++)
-            b->cen[i][a] = (float)(0.5 * ((double)b->box[i].lo[a] + b->box[i].hi[a]));
-        b->idx[m++] = i;
+        bvh_box box;
+        if (!prim_box(b->p, i, &box)) continue;
+        memcpy(b->ref[m].lo, box.lo, sizeof box.lo);
+        memcpy(b->ref[m].hi, box.hi, sizeof box.hi);
+        b->ref[m].id = i, b->ref[m].pad = 0;
+        m++;
     }
     return m;
 }
@@ -793,23 +846,26 @@ bvh *bvh_build(int n, const prims *p, int method)
     clock_t start = clock();
     bvh_builder b;
     bvh *t = NULL;
-    long m;
+    int *ids;
+    long m, k;
     memset(&b, 0, sizeof b);
     b.p = p, b.method = method;
     if (n < 0) n = 0;
-    b.box = malloc(((size_t)n + 1) * sizeof *b.box);
-    b.cen = malloc(((size_t)n + 1) * sizeof *b.cen);
-    b.idx = malloc(((size_t)n + 1) * sizeof *b.idx);
+    b.ref = malloc(((size_t)n + 1) * sizeof *b.ref);
     b.nodes = calloc(2 * (size_t)n + 2, sizeof *b.nodes);
-    if (b.box && b.cen && b.idx && b.nodes) {
+    ids = malloc(((size_t)n + 1) * sizeof *ids);
+    if (b.ref && b.nodes && ids) {
         m = gather(&b, n);
         if (m > 0) {
+            bvh_box box, cbox;
+            bounds_of(&b, 0, m, &box, &cbox);
             b.nnodes = 2;   /* the root, and the padding that aligns the pairs */
-            build_node(&b, 0, 0, m, 0);
+            build_node(&b, 0, 0, m, 0, &box, &cbox);
         }
-        t = finish(&b, m);
+        for (k = 0; k < m; k++) ids[k] = b.ref[k].id;
+        t = finish(&b, ids, m);
     }
-    free(b.box), free(b.cen), free(b.idx), free(b.nodes);
+    free(b.ref), free(b.nodes), free(ids);
     if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
     return t;
 }

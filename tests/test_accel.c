@@ -968,7 +968,7 @@ static void check_rays(const accel *A, const scene *s, const prims *p, const voi
         hits += want >= 0;
         if (!ok) bad_near++, bad_kind[kind]++;
         if (rec) rec_near++, bad_rec_near += !check_recursive(A, p, t, &r, kind, -1, tmin, tmax, 0);
-        if (k % 8 == 1 && want >= 0) {
+        if ((k % 8 == 1 || hits == 1) && want >= 0) {   /* the first hit, too: some scenes have few */
             skips++;
             if (!check_nearest(A, s, p, t, &r, kind, want, tmin, tmax, k, &w2, &w2_t, &c))
                 bad_skip++, bad_kind[kind]++;
