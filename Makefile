@@ -1,6 +1,6 @@
 # make          build everything with -O2 (override: make CC=clang CFLAGS=-O3)
 # make test     the test suite; ends with "N passed, N failed"
-# make stress   longer runs than make test: more kd-tree rays, every SPD scene
+# make stress   longer runs than make test: more rays for every acceleration structure, every SPD scene
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)
 # make spd      the seven SPD scenes at the benchmark's sizes, generated into scenes/spd/
@@ -20,8 +20,8 @@ PROGS = ray minray tools/ppmdiff tools/spd
 
 all: $(PROGS)
 
-ray: ray.c kdtree.c kdtree.h prims.h
-	$(CC) $(CFLAGS) $(FP) $(OMP) -o $@ ray.c kdtree.c $(LDLIBS)
+ray: ray.c kdtree.c kdtree.h bvh.c bvh.h grid.c grid.h prims.h
+	$(CC) $(CFLAGS) $(FP) $(OMP) -o $@ ray.c kdtree.c bvh.c grid.c $(LDLIBS)
 
 # The card is K&R C with implicit int: -w keeps its historical text quiet.
 minray: minray.c
@@ -44,7 +44,7 @@ scenes/spd/%.nff: tools/spd
 test: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/run.sh
 
-stress: all
+stress: all spd
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/stress.sh
 
 bench: all

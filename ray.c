@@ -116,6 +116,8 @@
 #endif
 #include "prims.h"
 #include "kdtree.h"
+#include "bvh.h"
+#include "grid.h"
 #ifdef _OPENMP
 #include <omp.h>
 #define OMP(directive) _Pragma(#directive)
@@ -206,13 +208,18 @@ typedef struct {
     int *emitter;             /* emitter[object]: its light, or -1 */
     char warning[256];        /* said once when the path tracer starts, if set */
     char whitted_warning[256];  /* the same for Whitted's */
-    int accel;                /* which structure finds hits: ACCEL_NONE or ACCEL_KD */
+    int accel;                /* which structure finds hits: an ACCEL_ below */
+    const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
     kd_tree *kd;              /* the kd-tree, when accel is ACCEL_KD */
+    bvh *bvh;                 /* the BVH, when accel is ACCEL_BVH */
+    grid *grid;               /* the grid, when accel is ACCEL_GRID */
     prims prims;              /* how the structure sees the objects (prims.h) */
 } Scene;
 
-/* --accel none: every ray tests every object; kd: the kd-tree of kdtree.c. */
-enum { ACCEL_NONE, ACCEL_KD };
+/* --accel none: every ray tests every object; kd: the kd-tree of kdtree.c;
+ * bvh: the bounding volume hierarchy of bvh.c; grid: the uniform grid of
+ * grid.c. */
+enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
 
 /* Whitted's recursive ray tracing, or Kajiya's path tracing; and the path
  * tracer's three estimators of the light at a point: by sampling the BSDF
@@ -1130,12 +1137,17 @@ static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk)
 {
     real ti;
     int i, best = -1;
-    if (s->accel == ACCEL_KD) {
+    if (s->accel != ACCEL_NONE) {
         double o[3], d[3], tmax = INFINITY;
         prim_counters c = { 0, 0, 0 };
         to3(q->r.o, o);
         to3(q->r.d, d);
-        best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
+        if (s->accel == ACCEL_KD)
+            best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
+        else if (s->accel == ACCEL_BVH)
+            best = bvh_nearest(s->bvh, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
+        else
+            best = grid_nearest(s->grid, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
         *t = (real)tmax;
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
@@ -1263,13 +1275,18 @@ static int find_any(const Scene *s, Query *q, real tmax, Worker *wk)
 {
     real t;
     int i;
-    if (s->accel == ACCEL_KD) {
+    if (s->accel != ACCEL_NONE) {
         double o[3], d[3];
         prim_counters c = { 0, 0, 0 };
         int hit;
         to3(q->r.o, o);
         to3(q->r.d, d);
-        hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
+        if (s->accel == ACCEL_KD)
+            hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
+        else if (s->accel == ACCEL_BVH)
+            hit = bvh_any(s->bvh, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
+        else
+            hit = grid_any(s->grid, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
         return hit;
@@ -2435,12 +2452,29 @@ static char *beside(const char *scene, const char *name)
     return p;
 }
 
+/* The structures --accel and a scene's `accel` line name (see build_accel):
+ * the name as a string that lasts, or NULL for an unknown one. */
+static const char *accel_name(const char *name)
+{
+    static const char *const names[] = { "kd", "bvh", "grid", "none", "auto" };
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (!strcmp(name, names[i])) return names[i];
+    return NULL;
+}
+
 /* A keyword line: ray.c's extensions to minray's format. */
 static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
 {
     real v[17];
     const char *k = tok[0];
     int mat, ok;
+    if (!strcmp(k, "accel")) {
+        if (ntok != 2 || !accel_name(tok[1]))
+            return fail(w, "expected `accel` and one of kd, bvh, grid, none, auto", NULL);
+        s->accel_line = accel_name(tok[1]);
+        return 1;
+    }
     if (!strcmp(k, "size"))
         return numbers(w, k, tok, ntok, 1, 2, v)
                && (check_size(v[0], v[1], &s->w, &s->h) || fail(w, SIZE_RULE, NULL));
@@ -3283,8 +3317,9 @@ static void usage(FILE *to)
           "  --p3       write plain-text P3 instead of binary P6\n"
           "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
           "             card's; a path-traced image always has it, but for PFM)\n"
-          "  --accel A  kd (the kd-tree), none (test every object) or auto (default:\n"
-          "             the tree from 8 objects up)\n"
+          "  --accel A  kd (the kd-tree), bvh (bounding volume hierarchy), grid\n"
+          "             (uniform grid), none (test every object) or auto (default:\n"
+          "             the scene's `accel` line, else the kd-tree from 8 objects up)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
           "  --help     this text\n", to);
 }
@@ -3323,12 +3358,12 @@ static const char *option_value(int argc, char **argv, int *i, const char *opt)
 /* --accel's value, or a usage error (exit 2) that lists the choices. */
 static const char *accel_arg(const char *v)
 {
-    if (strcmp(v, "kd") && strcmp(v, "none") && strcmp(v, "auto")) {
-        fprintf(stderr, "ray: --accel takes kd (the kd-tree), none (every object) or auto, not %s\n",
-                v);
+    if (!accel_name(v)) {
+        fprintf(stderr, "ray: --accel takes kd (the kd-tree), bvh (bounding volume hierarchy), grid"
+                " (uniform grid), none (every object) or auto, not %s\n", v);
         exit(2);
     }
-    return v;
+    return accel_name(v);
 }
 
 /* The path tracer's estimator named by --estimator, or exit with the choices. */
@@ -3413,9 +3448,9 @@ static char *default_output(const char *scene)
  * (5 spheres) the loop is 25% faster. */
 #define TREE_FROM 8
 
-/* Whether every object lies within the range the kd-tree's float boxes and
- * planes can hold (kdtree.c clamps beyond FLT_MAX), with float precision
- * to spare: coordinates below 1e37, and a scene that reaches beyond 1e-30
+/* Whether every object lies within the range the structures' float boxes
+ * and planes can hold (they clamp beyond FLT_MAX), with float precision to
+ * spare: coordinates below 1e37, and a scene that reaches beyond 1e-30
  * of the origin (nearer, floats lose their bits to denormals). */
 static int float_range(const Scene *s)
 {
@@ -3429,8 +3464,8 @@ static int float_range(const Scene *s)
 }
 
 /* The structure that answers nearest_hit and any_hit, as --accel says: the
- * kd-tree, none (every ray tests every object), or auto (the tree once the
- * scene has TREE_FROM objects). */
+ * kd-tree, the BVH (its SAH build), the grid, none (every ray tests every
+ * object), or auto (the kd-tree once the scene has TREE_FROM objects). */
 static int build_accel(Scene *s, const char *accel)
 {
     s->prims.bounds = prim_bounds;
@@ -3440,14 +3475,25 @@ static int build_accel(Scene *s, const char *accel)
     s->accel = ACCEL_NONE;
     if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
     if (!float_range(s)) {
-        fprintf(stderr, "ray: warning: coordinates beyond the float range the kd-tree keeps its planes"
-                " in (above 1e37, or a scene within 1e-30 of the origin): every ray tests every"
-                " object instead\n");
+        fprintf(stderr, "ray: warning: coordinates beyond the float range the structures keep their"
+                " boxes and planes in (above 1e37, or a scene within 1e-30 of the origin): every ray"
+                " tests every object instead\n");
         return 1;
     }
-    s->kd = kd_build(nobj(s), &s->prims);
-    if (!s->kd) { fprintf(stderr, "ray: out of memory for the kd-tree\n"); return 0; }
-    s->accel = ACCEL_KD;
+    if (!strcmp(accel, "bvh")) {
+        s->accel = ACCEL_BVH;
+        s->bvh = bvh_build(nobj(s), &s->prims, BVH_SAH);
+    } else if (!strcmp(accel, "grid")) {
+        s->accel = ACCEL_GRID;
+        s->grid = grid_build(nobj(s), &s->prims);
+    } else {
+        s->accel = ACCEL_KD;
+        s->kd = kd_build(nobj(s), &s->prims);
+    }
+    if (!s->kd && !s->bvh && !s->grid) {
+        fprintf(stderr, "ray: out of memory for the acceleration structure\n");
+        return 0;
+    }
     return 1;
 }
 
@@ -3473,8 +3519,22 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
                 "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
                 k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf,
                 k.bytes / 1e6, k.sah_cost, build);
+    } else if (s->accel == ACCEL_BVH) {
+        bvh_info b;
+        bvh_describe(s->bvh, &b);
+        fprintf(stderr, "bvh        %ld nodes, %ld leaves, depth %ld, %.2f objects per leaf,\n"
+                "           %lu bytes, SAH cost %.2f, built in %.3f s\n",
+                b.nodes, b.leaves, b.max_depth, b.prims_per_leaf, (unsigned long)b.bytes,
+                b.sah_cost, build);
+    } else if (s->accel == ACCEL_GRID) {
+        grid_info g;
+        grid_describe(s->grid, &g);
+        fprintf(stderr, "grid       %dx%dx%d cells (%ld empty), %.2f references per object,\n"
+                "           %lu bytes, built in %.3f s\n", g.res[0], g.res[1], g.res[2],
+                g.empty_cells, nobj(s) ? (double)g.prim_refs / nobj(s) : 0.0,
+                (unsigned long)g.bytes, build);
     } else
-        fprintf(stderr, "kd-tree    none: every ray tests every object\n");
+        fprintf(stderr, "accel      none: every ray tests every object\n");
     if (s->integrator == PATH) {
         char bound[32] = "none but roulette";
         if (s->max_rays) sprintf(bound, "%d rays", s->max_rays);
@@ -3501,6 +3561,8 @@ static void print_stats(const Scene *s, const Counts *st, int spp, double load, 
 static void free_scene(Scene *s)
 {
     if (s->kd) kd_free(s->kd);
+    if (s->bvh) bvh_free(s->bvh);
+    if (s->grid) grid_free(s->grid);
     free(s->mat); free(s->sph); free(s->cone); free(s->tri);
     free(s->vert); free(s->norm); free(s->light);
     free(s->emit); free(s->emit_cdf); free(s->emitter);
@@ -3558,7 +3620,7 @@ int main(int argc, char **argv)
     Counts st;
     Output out;
     Image img;
-    const char *scene = NULL, *size = NULL, *accel = "auto", *name = NULL;
+    const char *scene = NULL, *size = NULL, *accel = NULL, *name = NULL;
     char *auto_name = NULL;
     int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, w = 0, h = 0, integrator = -1;
     int estimator = -1, roulette = 1;
@@ -3608,6 +3670,7 @@ int main(int argc, char **argv)
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
     if (depth) s.depth = s.max_rays = depth;
+    if (!accel) accel = s.accel_line ? s.accel_line : "auto";
     if (ok && !settle_path_options(&s, integrator, estimator, roulette, seed)) ok = 0;
     if (!o.spp) o.spp = s.spp ? s.spp : 1;
     build = now();

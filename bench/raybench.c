@@ -1,6 +1,6 @@
 /* raybench.c - the kd-tree's build and traversal, measured on ray.c's own code.
  *
- *     cc -O2 -o raybench bench/raybench.c kdtree.c -lm      (no -fopenmp: one thread)
+ *     cc -O2 -o raybench bench/raybench.c kdtree.c bvh.c grid.c -lm     (no -fopenmp: one thread)
  *
  *     raybench build [MAXN]          build time against N on cube-spheres of 10k
  *                                    up to MAXN (default 1M) triangles, and the
@@ -120,6 +120,14 @@ static RbBox rb_box(const Scene *s)
     RbBox b;
     int i, k;
     for (k = 0; k < 3; k++) lo[k] = FLT_MAX, hi[k] = -FLT_MAX;
+    for (i = 0; i < s->nsph + s->ncone; i++) {   /* an NFF scene's spheres and cones */
+        double l[3], h[3];
+        prim_bounds((void *)s, i, l, h);
+        for (k = 0; k < 3; k++) {
+            if (l[k] < lo[k]) lo[k] = (float)l[k];
+            if (h[k] > hi[k]) hi[k] = (float)h[k];
+        }
+    }
     for (i = 0; i < s->nvert; i++) {
         float p[3];
         p[0] = (float)s->vert[i].x; p[1] = (float)s->vert[i].y; p[2] = (float)s->vert[i].z;
@@ -267,6 +275,8 @@ static int rb_white(Scene *s)
 static void rb_free_scene(Scene *s)
 {
     if (s->kd) kd_free(s->kd);
+    if (s->bvh) bvh_free(s->bvh);
+    if (s->grid) grid_free(s->grid);
     free(s->mat); free(s->sph); free(s->tri); free(s->vert); free(s->norm); free(s->light);
 }
 
@@ -303,6 +313,30 @@ static void rb_tree_line(const Scene *s, double seconds)
 
 /* ---------------------------------------------------------------- tracing */
 
+/* Ray i as the structures and ray.c's hit callback take it. */
+static Query rb_query(const RbRay *ray, double o[3], double d[3])
+{
+    Ray r;
+    int k;
+    for (k = 0; k < 3; k++) o[k] = ray->o[k], d[k] = ray->d[k];
+    r.o = v3(o[0], o[1], o[2]);
+    r.d = v3(d[0], d[1], d[2]);
+    r.skip = -1, r.tmin = 0;
+    return query(r);
+}
+
+/* What rtcIntersect1 returns besides the triangle and t: the barycentrics
+ * u and v, kept by the hit callback in q, and the unnormalised e1 x e2. */
+static void rb_uvn(const Scene *s, int obj, const Query *q, double h[5])
+{
+    const Triangle *tr;
+    vec ng;
+    if (obj < 0 || q->obj != obj) return;
+    tr = &s->tri[obj - (nobj(s) - s->ntri)];
+    ng = cross(tr->e1, tr->e2);
+    h[0] = q->u, h[1] = q->v, h[2] = ng.x, h[3] = ng.y, h[4] = ng.z;
+}
+
 /* Traces every ray once, single-threaded; the object hit (-1: none) and its
  * t go to obj and t.  bare = 0 asks nearest_hit(), what the renderer calls,
  * which also computes the hit point, the unit shading normal and the
@@ -326,17 +360,10 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
         r.skip = -1, r.tmin = 0;
         if (bare) {
             double o[3], d[3], tmax = INFINITY;
-            o[0] = r.o.x; o[1] = r.o.y; o[2] = r.o.z;
-            d[0] = r.d.x; d[1] = r.d.y; d[2] = r.d.z;
-            Query q = query(r);
+            Query q = rb_query(&rays[i], o, d);
             obj[i] = kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
             t[i] = tmax;
-            if (obj[i] >= 0 && q.obj == obj[i]) {
-                const Triangle *tr = &s->tri[obj[i] - (nobj(s) - s->ntri)];
-                vec ng = cross(tr->e1, tr->e2);
-                double *h = uvn + 5 * i;
-                h[0] = q.u, h[1] = q.v, h[2] = ng.x, h[3] = ng.y, h[4] = ng.z;
-            }
+            rb_uvn(s, obj[i], &q, uvn + 5 * i);
         } else {
             Hit h;
             if (nearest_hit(s, r, &h, &wk)) obj[i] = h.obj, t[i] = h.t;
@@ -428,14 +455,7 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
     s->prims.hit = rb_counting_hit;
     for (i = 0; i < n; i++) {
         double o[3], d[3], tmax = INFINITY;
-        Query q;
-        Ray r;
-        int k;
-        for (k = 0; k < 3; k++) o[k] = rays[i].o[k], d[k] = rays[i].d[k];
-        r.o = v3(o[0], o[1], o[2]);
-        r.d = v3(d[0], d[1], d[2]);
-        r.skip = -1, r.tmin = 0;
-        q = query(r);
+        Query q = rb_query(&rays[i], o, d);
         rb_probe.ray = (unsigned long)i + 1;
         kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, &c);
     }
@@ -569,6 +589,206 @@ static void rb_build_table(long maxn)
     printf("result exponent=%.4f\n", p);
 }
 
+/* ------------------------------------------------------- every structure */
+
+/* The structures compared by `raybench accel`: each traced on the same rays
+ * by the same loop, which asks one structure for the nearest hit and, for a
+ * triangle, reads u, v and the unnormalised Ng as rtcIntersect1 returns
+ * them.  -rec: the slide's recursive form of the same tree; none: a loop
+ * over every object (on a prefix of the rays: see rb_none_rays). */
+enum { RB_KD, RB_KD_REC, RB_BVH, RB_BVH_REC, RB_BVH_MEDIAN, RB_GRID, RB_NONE, RB_N };
+static const char *const rb_names[RB_N] = {
+    "kd", "kd-rec", "bvh-sah", "bvh-rec", "bvh-median", "grid", "none"
+};
+
+typedef struct {
+    Scene *s;
+    kd_tree *kd;
+    bvh *sah, *median;
+    grid *g;
+    double build[RB_N];     /* CPU seconds, best of the builds */
+    double bytes[RB_N];
+} RbAll;
+
+static double rb_cpu_build(RbAll *A, int which)
+{
+    const prims *p = &A->s->prims;
+    double c0 = rb_cpu();
+    int n = nobj(A->s);
+    switch (which) {
+    case RB_KD: if (A->kd) kd_free(A->kd); A->kd = kd_build(n, p); break;
+    case RB_BVH: if (A->sah) bvh_free(A->sah); A->sah = bvh_build(n, p, BVH_SAH); break;
+    case RB_BVH_MEDIAN: if (A->median) bvh_free(A->median); A->median = bvh_build(n, p, BVH_MEDIAN); break;
+    default: if (A->g) grid_free(A->g); A->g = grid_build(n, p);
+    }
+    return rb_cpu() - c0;
+}
+
+/* Builds every structure, best of three (of one past a second). */
+static void rb_build_all(RbAll *A)
+{
+    static const int built[4] = { RB_KD, RB_BVH, RB_BVH_MEDIAN, RB_GRID };
+    int k, r;
+    for (k = 0; k < 4; k++) {
+        double best = HUGE_VAL;
+        for (r = 0; r < 3 && (r == 0 || best < 1); r++) {
+            double c = rb_cpu_build(A, built[k]);
+            if (c < best) best = c;
+        }
+        A->build[built[k]] = best;
+    }
+    if (!A->kd || !A->sah || !A->median || !A->g) rb_die("out of memory building the structures", NULL);
+    {
+        kd_info ki;
+        bvh_info bi;
+        grid_info gi;
+        kd_describe(A->kd, &ki);
+        A->bytes[RB_KD] = A->bytes[RB_KD_REC] = (double)ki.bytes;
+        bvh_describe(A->sah, &bi);
+        A->bytes[RB_BVH] = A->bytes[RB_BVH_REC] = (double)bi.bytes;
+        bvh_describe(A->median, &bi);
+        A->bytes[RB_BVH_MEDIAN] = (double)bi.bytes;
+        grid_describe(A->g, &gi);
+        A->bytes[RB_GRID] = (double)gi.bytes;
+    }
+    A->build[RB_KD_REC] = A->build[RB_KD], A->build[RB_BVH_REC] = A->build[RB_BVH];
+}
+
+static int rb_nearest_with(const RbAll *A, int which, const double o[3], const double d[3],
+                           Query *q, double *t, prim_counters *c)
+{
+    const prims *p = &A->s->prims;
+    int i, best = -1, n = nobj(A->s);
+    switch (which) {
+    case RB_KD: return kd_nearest(A->kd, p, o, d, q, -1, 0, t, c);
+    case RB_KD_REC: return kd_intersect_recursive(A->kd, p, o, d, q, -1, 0, t, 0, c);
+    case RB_BVH: return bvh_nearest(A->sah, p, o, d, q, -1, 0, t, c);
+    case RB_BVH_REC: return bvh_intersect_recursive(A->sah, p, o, d, q, -1, 0, t, 0, c);
+    case RB_BVH_MEDIAN: return bvh_nearest(A->median, p, o, d, q, -1, 0, t, c);
+    case RB_GRID: return grid_nearest(A->g, p, o, d, q, -1, 0, t, c);
+    }
+    for (i = 0; i < n; i++) {   /* none */
+        double th;
+        if (p->hit(p->user, i, q, 0, *t, &th) && th < *t) *t = th, best = i;
+    }
+    if (c) c->rays++, c->tests += (unsigned long long)n;
+    return best;
+}
+
+/* One pass over the rays with one structure: the thread's CPU seconds.
+ * What a ray returns (triangle, t, u, v, Ng) goes to obj, t and uvn. */
+static double rb_pass(const RbAll *A, int which, const RbRay *rays, long n, int *obj, double *t,
+                      double *uvn, prim_counters *c)
+{
+    const Scene *s = A->s;
+    double c0 = rb_cpu();
+    long i;
+    for (i = 0; i < n; i++) {
+        double o[3], d[3], tmax = INFINITY;
+        Query q = rb_query(&rays[i], o, d);
+        obj[i] = rb_nearest_with(A, which, o, d, &q, &tmax, c);
+        t[i] = tmax;
+        rb_uvn(s, obj[i], &q, uvn + 5 * i);
+    }
+    return rb_cpu() - c0;
+}
+
+/* Brute force costs a test of every object per ray: it traces only as many
+ * rays as make about 2e7 tests, at least 200. */
+static long rb_none_rays(const Scene *s, long n)
+{
+    long k = (long)(2e7 / (nobj(s) > 0 ? nobj(s) : 1));
+    return k < 200 ? (n < 200 ? n : 200) : k < n ? k : n;
+}
+
+/* $RB_ACCELS (say "kd bvh-sah"): only those structures; all by default. */
+static int rb_wanted(int which)
+{
+    const char *only = getenv("RB_ACCELS"), *at;
+    size_t len = strlen(rb_names[which]);
+    if (!only || !*only) return 1;
+    for (at = strstr(only, rb_names[which]); at; at = strstr(at + 1, rb_names[which]))
+        if ((at == only || at[-1] == ' ' || at[-1] == ',') && (at[len] == 0 || at[len] == ' ' || at[len] == ','))
+            return 1;
+    return 0;
+}
+
+static int rb_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Every structure on one set of rays, in ROUNDS rounds, each round tracing
+ * with every structure in turn, so that all meet the machine's drift
+ * alike.  Prints Mrays/s by CPU time, the best, median and worst round,
+ * and whether each structure's answers equal the kd-tree's (triangle or
+ * object and bitwise t). */
+#define RB_ROUNDS 5
+static void rb_accel_set(const RbAll *A, const char *set, const RbRay *rays, long n)
+{
+    int *obj[RB_N], w, r;
+    double *t[RB_N], *uvn = malloc((size_t)n * 5 * sizeof *uvn), secs[RB_N][RB_ROUNDS];
+    prim_counters c[RB_N];
+    long hits = 0, i;
+    if (!uvn) rb_die("out of memory for hits", NULL);
+    for (w = 0; w < RB_N; w++) {
+        obj[w] = malloc((size_t)n * sizeof(int));
+        t[w] = malloc((size_t)n * sizeof(double));
+        if (!obj[w] || !t[w]) rb_die("out of memory for hits", NULL);
+        memset(&c[w], 0, sizeof c[w]);
+        if (w == RB_KD || rb_wanted(w))
+            rb_pass(A, w, rays, w == RB_NONE ? rb_none_rays(A->s, n) : n, obj[w], t[w], uvn, &c[w]);
+    }
+    for (r = 0; r < RB_ROUNDS; r++)
+        for (w = 0; w < RB_N; w++)
+            if (rb_wanted(w)) secs[w][r] = rb_pass(A, w, rays, w == RB_NONE ? rb_none_rays(A->s, n) : n, obj[w],
+                                 t[w], uvn, NULL);
+    for (i = 0; i < n; i++) hits += obj[RB_KD][i] >= 0;
+    printf("%s: %ld rays, %ld hit (%.1f%%); Mrays/s by thread CPU time, best / median / worst of %d "
+           "rounds, the structures taking turns\n", set, n, hits, 100.0 * hits / n, RB_ROUNDS);
+    for (w = 0; w < RB_N; w++) {
+        long m = w == RB_NONE ? rb_none_rays(A->s, n) : n, diff = 0;
+        double mr[RB_ROUNDS];
+        if (!rb_wanted(w)) continue;
+        for (r = 0; r < RB_ROUNDS; r++) mr[r] = m / secs[w][r] * 1e-6;
+        qsort(mr, RB_ROUNDS, sizeof mr[0], rb_cmp_double);
+        for (i = 0; i < m; i++)
+            diff += obj[w][i] != obj[RB_KD][i] || memcmp(&t[w][i], &t[RB_KD][i], sizeof(double));
+        printf("  %-10s %8.3f %8.3f %8.3f Mrays/s  %7.2f steps %7.2f tests per ray  build %.4f s  "
+               "%.1f MB  %s\n", rb_names[w], mr[RB_ROUNDS - 1], mr[RB_ROUNDS / 2], mr[0],
+               (double)c[w].steps / m, (double)c[w].tests / m, A->build[w], A->bytes[w] / 1e6,
+               diff ? "DIFFERS from kd" : "same answers as kd");
+        printf("result set=%s accel=%s rays=%ld best=%.4f median=%.4f worst=%.4f steps=%.3f tests=%.3f "
+               "build_s=%.5f bytes=%.0f differ=%ld\n", set, rb_names[w], m, mr[RB_ROUNDS - 1],
+               mr[RB_ROUNDS / 2], mr[0], (double)c[w].steps / m, (double)c[w].tests / m, A->build[w],
+               A->bytes[w], diff);
+    }
+    for (w = 0; w < RB_N; w++) free(obj[w]), free(t[w]);
+    free(uvn);
+}
+
+/* A mesh (.obj) or a scene (.nff, spheres and cones included), with every
+ * structure built over it. */
+static void rb_load_any(Scene *s, RbAll *A, const char *path)
+{
+    const char *dot = strrchr(path, '.');
+    if (dot && !strcmp(dot, ".nff")) {
+        if (!load_scene(s, path)) exit(1);
+    } else
+        rb_load_mesh(s, path);
+    if (!build_accel(s, "none")) exit(1);   /* sets the callbacks */
+    memset(A, 0, sizeof *A);
+    A->s = s;
+    rb_build_all(A);
+    printf("scene %s: %d objects (%d triangles)\n", path, nobj(s), s->ntri);
+}
+
+static void rb_free_all(RbAll *A)
+{
+    kd_free(A->kd), bvh_free(A->sah), bvh_free(A->median), grid_free(A->g);
+}
+
 /* ------------------------------------------------------------------ main */
 
 static long rb_count(const char *arg, long max)
@@ -579,11 +799,40 @@ static long rb_count(const char *arg, long max)
     return v;
 }
 
+/* The rays made here for `made` and `accel`: W x H primary rays (arg[0],
+ * arg[1]) from the view, then N random ones (arg[2]), each set handed to
+ * trace with ctx. */
+typedef void rb_tracer(void *ctx, const char *set, const RbRay *rays, long n);
+static void rb_made(Scene *s, char **arg, const char *view, rb_tracer *trace, void *ctx)
+{
+    int w = (int)rb_count(arg[0], 32768), h = (int)rb_count(arg[1], 32768);
+    long n = rb_count(arg[2], 100000000);
+    RbRay *rays = rb_primary(s, w, h, view);
+    trace(ctx, "primary", rays, (long)w * h);
+    free(rays);
+    rays = rb_random(s, n, 1);
+    trace(ctx, "random", rays, n);
+    free(rays);
+}
+
+static void rb_kd_trace(void *s, const char *set, const RbRay *rays, long n)
+{
+    rb_rays(s, set, rays, n);
+}
+
+static void rb_accel_trace(void *A, const char *set, const RbRay *rays, long n)
+{
+    rb_accel_set(A, set, rays, n);
+}
+
 static void rb_usage(void)
 {
     fputs("usage: raybench build [MAXN]\n"
           "       raybench rays MESH.obj RAYS.bin...     (RAYHITS1, from embree_rays -out)\n"
-          "       raybench made MESH.obj W H N [VIEW.nff] (W x H primary and N random rays)\n", stderr);
+          "       raybench made MESH.obj W H N [VIEW.nff] (W x H primary and N random rays)\n"
+          "       raybench accel SCENE W H N [VIEW.nff]   (every structure on W x H primary and N\n"
+          "                                                random rays; SCENE .obj or .nff)\n"
+          "       raybench accel SCENE RAYS.bin...        (every structure on RAYHITS1 rays)\n", stderr);
     exit(2);
 }
 
@@ -593,6 +842,28 @@ int main(int argc, char **argv)
     if (argc < 2) rb_usage();
     if (!strcmp(argv[1], "build") && argc <= 3) {
         rb_build_table(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
+        return 0;
+    }
+    if (!strcmp(argv[1], "accel") && argc >= 4) {
+        RbAll A;
+        const char *dot = strrchr(argv[3], '.');
+        rb_load_any(&s, &A, argv[2]);
+        if (dot && !strcmp(dot, ".bin")) {
+            int k;
+            for (k = 3; k < argc; k++) {
+                long n;
+                RbRay *rays = rb_read_rayhits(argv[k], &n);
+                rb_accel_set(&A, strstr(argv[k], "random") ? "random" : "primary", rays, n);
+                free(rays);
+            }
+        } else if (argc == 6 || argc == 7) {
+            const char *sdot = strrchr(argv[2], '.');
+            rb_made(&s, argv + 3, argc == 7 ? argv[6] : sdot && !strcmp(sdot, ".nff") ? argv[2] : NULL,
+                    rb_accel_trace, &A);
+        } else
+            rb_usage();
+        rb_free_all(&A);
+        rb_free_scene(&s);
         return 0;
     }
     if (!strcmp(argv[1], "rays") && argc >= 4) {
@@ -610,16 +881,8 @@ int main(int argc, char **argv)
             free(rays);
         }
     } else if (!strcmp(argv[1], "made") && (argc == 6 || argc == 7)) {
-        int w = (int)rb_count(argv[3], 32768), h = (int)rb_count(argv[4], 32768);
-        long n = rb_count(argv[5], 100000000);
-        RbRay *rays;
         rb_mesh(&s, argv[2]);
-        rays = rb_primary(&s, w, h, argc == 7 ? argv[6] : NULL);
-        rb_rays(&s, "primary", rays, (long)w * h);
-        free(rays);
-        rays = rb_random(&s, n, 1);
-        rb_rays(&s, "random", rays, n);
-        free(rays);
+        rb_made(&s, argv + 3, argc == 7 ? argv[6] : NULL, rb_kd_trace, &s);
     } else
         rb_usage();
     rb_free_scene(&s);

@@ -16,6 +16,13 @@
 #   rays    traversal Mrays/s on meshes, one thread, primary and random rays,
 #           against Embree's rtcIntersect1 on the very same rays, hits
 #           compared ray by ray (bench/raybench.c, ../shared/embree)
+#   accel   every structure on the same rays, one thread: for each SPD scene
+#           and the 100k-triangle sphere, build time, memory, primary- and
+#           random-ray Mrays/s (CPU time, best / median / worst of 5 rounds,
+#           the structures taking turns) for kd, bvh-sah, bvh-median, grid
+#           and none, and the recursive forms kd-rec and bvh-rec; Embree on
+#           the sphere's very rays, alternating with ours (bench/raybench.c
+#           accel)
 #   pov     SPD balls at 512x512, one thread: ./ray against --accel none and
 #           against POV-Ray 3.7; and POV-Ray's other SPD scenes
 #   pt      the path tracer: each estimator's CPU time against its RMSE on the
@@ -32,7 +39,7 @@
 #   *.log       the raw output each table was read from
 #
 # Knobs (environment; defaults keep `make bench` near 4 minutes on 2 cores):
-#   BENCH_PARTS="render spd build rays pov pt"
+#   BENCH_PARTS="render spd build rays accel pov pt"
 #   BENCH_SPP="1 4 16"       sample counts to time
 #   BENCH_REF_SPP=64         reference sample count (should exceed the above)
 #   BENCH_FLAKE_LEVEL=4      sphereflake recursion (4: 7381 spheres)
@@ -56,6 +63,12 @@
 #                            from its own camera
 #   BENCH_RAYS_RES=1024      primary rays: a square image of this side
 #   BENCH_RAYS_N=1000000     random rays
+#   BENCH_ACCEL_SPD="balls_s4 ..."  the SPD scenes of the accel section
+#                            (default: BENCH_SPD), from BENCH_SPD_DIR, else
+#                            from scenes/spd (make spd)
+#   BENCH_ACCEL_RES=512      their primary rays: a square image of this side,
+#                            from the scene's own camera
+#   BENCH_ACCEL_N=300000     their random rays
 #   BENCH_INSTALL=1          try apt-get for a missing Embree or POV-Ray
 #   BENCH_BALLS_NONE_FULL=1  brute force renders balls at 512x512 for the
 #                            speed-up target (about 35 s); 0: its time per
@@ -74,7 +87,7 @@ FLAKE_SIZE=${BENCH_FLAKE_SIZE:-}
 FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
-PARTS=${BENCH_PARTS:-render spd build rays pov pt}
+PARTS=${BENCH_PARTS:-render spd build rays accel pov pt}
 SPD_DIR=${BENCH_SPD_DIR:-../shared/spd}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
 NONE_BUDGET=${BENCH_NONE_BUDGET:-2}
@@ -98,7 +111,7 @@ for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N; do
   case $n in ''|*[!0-9]*|0) die "BENCH_NONE_BUDGET, BENCH_BUILD_MAX, BENCH_RAYS_RES and BENCH_RAYS_N must be whole numbers from 1, not '$n'";; esac
 done
 for p in $PARTS; do
-  case $p in render|spd|build|rays|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays pov pt)";; esac
+  case $p in render|spd|build|rays|accel|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel pov pt)";; esac
 done
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT" || die "cannot create $OUT"
@@ -111,9 +124,12 @@ status=0   # 1 once a section of ours (not an instrument) failed
 # ./ray is stale.  OpenMP is detected as the Makefile does.
 OMP=$(echo 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
 RAYSRC=(ray.c)
-# kdtree.c is linked once ray.c uses it, not merely because it exists: a
-# half-written tree must not break the bench of a renderer that ignores it.
-if grep -q '^#include "kdtree.h"' ray.c && [ -f kdtree.c ]; then RAYSRC+=(kdtree.c); fi
+# Each acceleration module is linked once ray.c uses it, not merely because
+# it exists: a half-written one must not break the bench of a renderer that
+# ignores it.
+for m in kdtree bvh grid; do
+  if grep -q "^#include \"$m.h\"" ray.c && [ -f $m.c ]; then RAYSRC+=($m.c); fi
+done
 
 build() {  # build OUTPUT CC-ARGS...
   local out=$1; shift
@@ -140,7 +156,7 @@ build "$OUT/svgplot" bench/svgplot.c
 RAYBENCH=$OUT/raybench
 # $CFLAGS is split into words on purpose, as make does.
 # shellcheck disable=SC2086
-if ! $CC $CFLAGS -o "$RAYBENCH" bench/raybench.c kdtree.c -lm 2>"$OUT/raybench-build.log"; then
+if ! $CC $CFLAGS -o "$RAYBENCH" bench/raybench.c "${RAYSRC[@]:1}" -lm 2>"$OUT/raybench-build.log"; then
   cat "$OUT/raybench-build.log" >&2
   say "bench/raybench.c does not build: the build and rays sections will be skipped"
   RAYBENCH=
@@ -510,9 +526,10 @@ make_mesh() {
   mv "$tmp" "$mesh_obj"
 }
 
-if part rays; then
-  t_part=$SECONDS
-  # Embree's harness, built here as its README says (the project never links it).
+# find_embree: Embree's harness, built here as its README says (the project
+# never links it), in $embree; empty, with the reason in $embree_why, when
+# it cannot be had.
+find_embree() {
   embree=
   if [ ! -f "$EMBREE_DIR/embree_rays.c" ]; then
     embree_why="harness not found ($EMBREE_DIR/embree_rays.c), skipped"
@@ -525,6 +542,11 @@ if part rays; then
       embree_why="not installed, skipped (libembree-dev; BENCH_INSTALL=1 tries apt-get)"
     fi
   fi
+}
+
+if part rays; then
+  t_part=$SECONDS
+  find_embree
   {
     echo "Traversal, one thread: ray.c's nearest_hit() (tree walk, triangle test, hit point and normals) on ${RAYS_RES}x${RAYS_RES}"
     echo "primary and $RAYS_N random rays, best of 5 runs in each of 2 rounds; 'walk': kd_nearest() and then the triangle's u, v and"
@@ -635,6 +657,117 @@ if part rays; then
     echo "(steps, tests: tree steps and hit tests per ray; repeat%: tests of a primitive already tested by that ray, which the mailbox missed)"
     [ ${#builds[@]} -gt 0 ] && printf '%s\n' "${builds[@]}"
     echo "($((SECONDS - t_part)) s)"
+    echo
+  } | tee -a "$OUT/bench.txt"
+fi
+
+# ------------------------------------------- every structure, same rays
+# accel_rows LOG SCENE: the table's rows from raybench accel's result lines.
+accel_rows() {
+  awk -v scene="$2" '
+    $1 == "result" && $3 ~ /^accel=/ {
+      for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
+      a = v["accel"]
+      if (!(a in build)) { build[a] = v["build_s"]; bytes[a] = v["bytes"]; names[++m] = a }
+      if (v["build_s"] < build[a]) build[a] = v["build_s"]
+      # of several runs (rounds against Embree), the one with the best median
+      if (v["median"] + 0 < med[a, v["set"]]) next
+      med[a, v["set"]] = v["median"] + 0
+      fig[a, v["set"]] = sprintf("%6.2f %6.2f %6.2f", v["best"], v["median"], v["worst"])
+      work[a, v["set"]] = sprintf("%5.1f %5.1f", v["steps"], v["tests"])
+      if (v["differ"] > 0) bad[a] = bad[a] " " v["set"] ":" v["differ"] }
+    END {
+      for (k = 1; k <= m; k++) { a = names[k]
+        printf "%-11s %-10s %8.4f %7.2f  %s  %s  %s  %s  %s\n", scene, a, build[a], bytes[a] / 1e6,
+          fig[a, "primary"], fig[a, "random"], work[a, "primary"], work[a, "random"],
+          (a in bad) ? "DIFFER" bad[a] : "same" } }' "$1"
+}
+
+if part accel; then
+  t_part=$SECONDS
+  find_embree
+  ACCEL_SPD=${BENCH_ACCEL_SPD:-$SPD_SCENES}
+  ACCEL_RES=${BENCH_ACCEL_RES:-512}
+  ACCEL_N=${BENCH_ACCEL_N:-300000}
+  {
+    echo "Every structure on the same rays, one thread (bench/raybench.c accel): the loop asks one structure for the"
+    echo "nearest hit and reads u, v, Ng for a triangle, as rtcIntersect1 returns.  Mrays/s by thread CPU time, best /"
+    echo "median / worst of 5 rounds, the structures taking turns.  SPD scenes: ${ACCEL_RES}x${ACCEL_RES} primary rays"
+    echo "from the scene's camera and $ACCEL_N random rays (origins in the scene box x1.5, uniform directions);"
+    echo "sphere100k: Embree's own ${RAYS_RES}x${RAYS_RES} primary and $RAYS_N random rays.  none traces a prefix of"
+    echo "the rays (about 2e7 tests).  build: CPU seconds, best of 3; -rec: the slide's recursive form of the same"
+    echo "tree.  answers: every structure's (object, bitwise t) against the kd-tree's, ray by ray."
+    echo
+    printf '%-11s %-10s %8s %7s  %-20s  %-20s  %-11s  %-11s  %s\n' scene structure "build s" MB \
+      "primary Mrays/s" "random Mrays/s" "prim st/te" "rand st/te" answers
+  } | tee -a "$OUT/bench.txt"
+  if [ -z "$RAYBENCH" ]; then
+    echo "bench/raybench.c did not build: skipped" | tee -a "$OUT/bench.txt"
+  else
+    for name in $ACCEL_SPD; do
+      scene=$SPD_DIR/$name.nff
+      [ -f "$scene" ] || scene=scenes/spd/$name.nff
+      if [ ! -f "$scene" ]; then
+        printf '%-11s not found in %s or scenes/spd (make spd): skipped\n' "$name" "$SPD_DIR" | tee -a "$OUT/bench.txt"
+        continue
+      fi
+      say "accel: $name"
+      log=$OUT/accel-$name.log
+      if "$RAYBENCH" accel "$scene" "$ACCEL_RES" "$ACCEL_RES" "$ACCEL_N" >"$log" 2>&1; then
+        accel_rows "$log" "$name" | tee -a "$OUT/bench.txt"
+      else
+        printf '%-11s raybench failed, see %s\n' "$name" "$log" | tee -a "$OUT/bench.txt"
+        status=1
+      fi
+    done
+    mname=sphere100k
+    if make_mesh "$mname"; then
+      log=$OUT/accel-$mname.log
+      : >"$log"
+      emb_p='' emb_r='' emb_b='' rc=0
+      for round in 1 2; do
+        if [ -n "$embree" ]; then
+          say "accel: $mname: Embree (round $round)"
+          elog=$OUT/accel-embree-$round.log
+          if "$embree" "$mesh_obj" -mode both -res "$RAYS_RES" "$RAYS_RES" -nrays "$RAYS_N" -quality default \
+            -threads 1 -buildthreads 1 -repeat 5 -out "$OUT/accel-embree" >"$elog" 2>&1; then
+            emb_b=$(best_of "$emb_b" "$(sed -n 's/.*BUILD quality=[^:]*: \([0-9.]*\) s.*/\1/p' "$elog" | head -n 1)" min)
+            emb_p=$(best_of "$emb_p" "$(grep -A1 'TRACE primary' "$elog" | sed -n 's/.*thread CPU time: best [0-9.]* s = \([0-9.]*\) Mrays.*/\1/p' | head -n 1)" max)
+            emb_r=$(best_of "$emb_r" "$(grep -A1 'TRACE random' "$elog" | sed -n 's/.*thread CPU time: best [0-9.]* s = \([0-9.]*\) Mrays.*/\1/p' | head -n 1)" max)
+          fi
+        fi
+        say "accel: $mname: ours (round $round)"
+        if [ -f "$OUT/accel-embree_primary.bin" ] && [ -f "$OUT/accel-embree_random.bin" ]; then
+          "$RAYBENCH" accel "$mesh_obj" "$OUT/accel-embree_primary.bin" "$OUT/accel-embree_random.bin" >>"$log" 2>&1 || rc=1
+        else
+          "$RAYBENCH" accel "$mesh_obj" "$RAYS_RES" "$RAYS_RES" "$RAYS_N" >>"$log" 2>&1 || rc=1
+        fi
+      done
+      if [ "$rc" != 0 ]; then
+        printf '%-11s raybench failed, see %s\n' "$mname" "$log" | tee -a "$OUT/bench.txt"
+        status=1
+      else
+        accel_rows "$log" "$mname" | tee -a "$OUT/bench.txt"
+        if [ -n "$emb_p" ]; then
+          printf '%-11s %-10s %8.4f %7s  %6.2f %-13s  %6.2f %-13s  (wall-clock build; CPU-time trace, best of 2 runs of 5)\n' \
+            "$mname" Embree "$emb_b" - "$emb_p" "" "$emb_r" "" | tee -a "$OUT/bench.txt"
+          best_p=$(awk '$1 == "result" && $2 == "set=primary" && $3 !~ /none|rec/ { split($5, b, "="); if (b[2] > m) m = b[2] } END { print m }' "$log")
+          best_r=$(awk '$1 == "result" && $2 == "set=random" && $3 !~ /none|rec/ { split($5, b, "="); if (b[2] > m) m = b[2] } END { print m }' "$log")
+          sah_b=$(awk '$1 == "result" && $3 == "accel=bvh-sah" { split($10, b, "="); print b[2]; exit }' "$log")
+          rp=$(awk "BEGIN { printf \"%.2f\", $best_p / $emb_p }") rr=$(awk "BEGIN { printf \"%.2f\", $best_r / $emb_r }")
+          rb=$(awk "BEGIN { printf \"%.2f\", $sah_b / $emb_b }")
+          targets+=("sphere100k, one thread, CPU time: best of ours $best_p Mrays/s primary against Embree $emb_p: ${rp}x (target >= 0.8): $(verdict "$rp >= 0.8"); random $best_r against $emb_r: ${rr}x (target >= 0.5): $(verdict "$rr >= 0.5")")
+          targets+=("sphere100k BVH SAH build $sah_b s (CPU) against Embree's $emb_b s (wall, one thread): ${rb}x (target <= 1.5): $(verdict "$rb <= 1.5")")
+        else
+          echo "(Embree: ${embree_why:-not run}; the rays were made here by its conventions)" | tee -a "$OUT/bench.txt"
+        fi
+      fi
+    else
+      printf '%-11s cannot make the mesh (%s): skipped\n' "$mname" "$mesh_why" | tee -a "$OUT/bench.txt"
+    fi
+  fi
+  {
+    echo "(st/te: steps (nodes, cells) and hit tests per ray.  $((SECONDS - t_part)) s)"
     echo
   } | tee -a "$OUT/bench.txt"
 fi

@@ -131,3 +131,18 @@ printf 'camera 0 0 0 0 1 0 0 0 1 40\n0 4 0  1 1 1 1  0 1 1 0 1.3\n0 4 0  1 1 1 .
   && grep -q "^budget .* not traced" "$TMP/err" \
   && ok "ks + kt = 2 at depth 64: bounded by the ray budget, counted, one file:line warning" \
   || bad "ks + kt = 2: exit $rc, $(head -c 300 "$TMP/err")"
+
+# The acceleration structure: --accel, or the scene's `accel` line; the
+# option wins.  Every structure gives the same picture.
+bad_scene "unknown structure" "expected \`accel\` and one of kd, bvh, grid, none, auto" "accel octree\n$good\n"
+for a in kd bvh grid none; do
+  ./ray -s 24x24 --stats --accel $a -o "$TMP/acc_$a.ppm" scenes/whitted.sph 2> "$TMP/acc_$a.err" || bad "--accel $a"
+done
+cmp -s "$TMP/acc_kd.ppm" "$TMP/acc_bvh.ppm" && cmp -s "$TMP/acc_kd.ppm" "$TMP/acc_grid.ppm" \
+  && cmp -s "$TMP/acc_kd.ppm" "$TMP/acc_none.ppm" && ok "--accel kd, bvh, grid and none: the same picture" \
+  || bad "--accel kd, bvh, grid and none give different pictures"
+printf 'accel grid\n%s\n%s\n%s\n' "$good" "$good" "$good" > "$TMP/g.sph"
+./ray -s 8x8 --stats -o "$TMP/g.ppm" "$TMP/g.sph" 2>&1 | grep -q '^grid ' && ok "scene line accel grid: the grid answers" \
+  || bad "scene line accel grid ignored"
+./ray -s 8x8 --stats --accel bvh -o "$TMP/g.ppm" "$TMP/g.sph" 2>&1 | grep -q '^bvh ' && ok "--accel bvh overrides the scene's accel line" \
+  || bad "--accel does not override the scene's accel line"

@@ -47,7 +47,7 @@ cmp -s "$TMP/got" "$TMP/want" && ok "--gamma gives the sRGB curve's bytes, linea
 # points, CRC-32 and Adler-32 check values, extensions, and paths split as
 # POSIX and (-DRAY_DOS_PATHS) as Windows splits them.
 for paths in "" -DRAY_DOS_PATHS; do
-  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c kdtree.c -lm 2> "$TMP/err"; then
+  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c kdtree.c bvh.c grid.c -lm 2> "$TMP/err"; then
     "$TMP/test_io"
   else
     bad "tests/test_io.c $paths compiles: $(head -3 "$TMP/err")"
@@ -124,9 +124,9 @@ done
   && ./ray -s16x8 -n3 -d2 -t1 --accel=kd -o"$TMP/attached.ppm" scenes/whitted.sph \
   && cmp -s "$TMP/spaced.ppm" "$TMP/attached.ppm" && ok "-s16x8 -n3 -d2 -t1 --accel=kd -oFILE: as with spaces" \
   || bad "attached option values"
-./ray --accel bvh scenes/minray.sph 2> "$TMP/err"; rc=$?
-[ $rc = 2 ] && grep -q "kd.*none.*auto.*not bvh" "$TMP/err" && ok "--accel bvh: exit 2, $(cat "$TMP/err")" \
-  || bad "--accel bvh: exit $rc, $(cat "$TMP/err")"
+./ray --accel octree -o "$TMP/o.ppm" scenes/whitted.sph 2> "$TMP/err"; rc=$?
+[ $rc = 2 ] && grep -q "kd.*bvh.*grid.*none.*auto.*not octree" "$TMP/err" && ok "--accel octree: exit 2, $(cat "$TMP/err")" \
+  || bad "--accel octree: exit $rc, $(cat "$TMP/err")"
 printf '%s\n' '0 6 .5  1 1 1  .9 .05 .2 .85 0 1.7' > "$TMP/s.sph"
 for args in "--bogus" "-n 0" "-n x" "-n" "-s 0x10" "-s axb" "-s" "-d 65" "-t 0" "--accel" "--accel=" \
             "--accelx" "-o $TMP/x.gif" "$TMP/s.sph"; do
@@ -144,7 +144,7 @@ done
 [ $rc = 0 ] && grep -qE "^ray [0-9]+\.[0-9]+" "$TMP/out.txt" && ok "--version: $(cat "$TMP/out.txt")" \
   || bad "--version: exit $rc, $(cat "$TMP/out.txt")"
 # -t without OpenMP: one warning however often -t is given; with it, none.
-if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c kdtree.c -lm 2> "$TMP/err"; then
+if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c kdtree.c bvh.c grid.c -lm 2> "$TMP/err"; then
   "$TMP/ray_serial" -t 2 -t 3 -s 4x4 -o "$TMP/t.ppm" scenes/whitted.sph 2> "$TMP/err"
   [ "$(grep -c "warning: -t 3 is ignored" "$TMP/err")" = 1 ] && [ "$(wc -l < "$TMP/err")" = 1 ] \
     && ok "-t without OpenMP warns once: $(cat "$TMP/err")" || bad "-t without OpenMP: $(cat "$TMP/err")"

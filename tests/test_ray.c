@@ -371,14 +371,15 @@ static void test_sphere_clip(void)
            "mean volume ratio %.3f over %g cells", gain / cells, (double)cells);
 }
 
-/* The kd-tree must give what the loop gives: same object, same t, bit for
- * bit, for a scene of spheres and triangles and rays of every awkward kind. */
-static void test_tree_matches_loop(void)
+/* Each structure (kd, bvh, grid) must give what the loop gives: same
+ * object, same t, bit for bit, for a scene of spheres and triangles and
+ * rays of every awkward kind. */
+static void test_tree_matches_loop(const char *accel, int n)
 {
     Scene s = tri_scene(0);
     Worker wk;
     unsigned long long x = 7;
-    int r, k, wrong = 0, n = 1000000;
+    int r, k, wrong = 0, used;
     memset(&wk, 0, sizeof wk);
     uv_sphere(&s, 6, 12, 1);
     for (k = 0; k < 60; k++) {          /* random spheres and triangles in [-3, 3]^3 */
@@ -390,7 +391,8 @@ static void test_tree_matches_loop(void)
     add_cone(&s, v3(0, 0, -2), 0.5, v3(0, 0, 2), 0.5, 0);      /* along z: axis-parallel rays */
     tri(&s, v3(-4, -4, -1), v3(4, -4, -1), v3(-4, 4, -1));     /* axis-aligned: splits land on it */
     tri(&s, v3(0, 0, 0), v3(0, 2, 0), v3(0, 0, 2));
-    build_accel(&s, "kd");
+    build_accel(&s, accel);
+    used = s.accel;
     for (r = 0; r < n; r++) {
         Hit a, b;
         int ha, hb;
@@ -407,11 +409,15 @@ static void test_tree_matches_loop(void)
         ha = nearest_hit(&s, ry, &a, &wk);
         s.accel = ACCEL_NONE;
         hb = nearest_hit(&s, ry, &b, &wk);
-        s.accel = ACCEL_KD;
+        s.accel = used;
         if (ha != hb || (ha && (a.obj != b.obj || a.t != b.t))) wrong++;
     }
-    report(wrong == 0, "kd-tree = loop (spheres, cones, triangles): same object and t, 1e6 rays (axis-parallel, in planes, inside)",
-           "%g mismatches of %g", wrong, n);
+    {
+        char name[160];
+        sprintf(name, "%s = loop (spheres, cones, triangles): same object and t (axis-parallel rays, "
+                "in planes, inside)", accel);
+        report(wrong == 0 && used != ACCEL_NONE, name, "%g mismatches of %g", wrong, n);
+    }
     free_scene(&s);
 }
 
@@ -421,14 +427,14 @@ static void test_tree_matches_loop(void)
  * two of the lights stand among the balls, so that the cached blocker often
  * lies beyond the light or misses.  A cache that tested its object without
  * the light's distance darkens 41 pixels here. */
-static void test_tree_image(void)
+static void test_tree_image(const char *accel)
 {
     Scene s = tri_scene(0);
     Material mirror;
     Worker wk;
     unsigned long long x = 3;
     real v[10] = { 0, -9, 6, 0, 0, 0.5, 0, 0, 1, 45 };
-    int i, j, k, W = 96, wrong = 0, mat;
+    int i, j, k, W = 96, wrong = 0, mat, used;
     memset(&wk, 0, sizeof wk);
     mirror = s.mat[0];
     mirror.kd = 0.6, mirror.ks = 0.4, mirror.shine = 20;
@@ -441,7 +447,8 @@ static void test_tree_image(void)
     add_light(&s, v3(0.3, 0.2, 0.6), v3(0.4, 0.4, 0.4), -1);
     add_light(&s, v3(-1.5, 1.1, 0.4), v3(0.3, 0.3, 0.3), -1);
     set_camera(&s, (Where){ "", 0 }, v);
-    build_accel(&s, "kd");
+    build_accel(&s, accel);
+    used = s.accel;
     for (j = 0; j < W; j++) {
         for (k = 0; k < SHADOW_SLOTS; k++) wk.blocker[k] = -1;
         for (i = 0; i < W; i++) {
@@ -449,12 +456,16 @@ static void test_tree_image(void)
                 vec a = trace(&s, r, s.depth, 1, &wk), b;
             s.accel = ACCEL_NONE;
             b = trace(&s, r, s.depth, 1, &wk);
-            s.accel = ACCEL_KD;
+            s.accel = used;
             wrong += memcmp(&a, &b, sizeof a) != 0;
         }
     }
-    report(wrong == 0, "kd-tree = loop: whole pixels bit for bit (shadows, mirrors, lights among the balls)",
-           "%g of %g pixels differ", wrong, W * W);
+    {
+        char name[160];
+        sprintf(name, "%s = loop: whole pixels bit for bit (shadows, mirrors, lights among the balls)",
+                accel);
+        report(wrong == 0 && used != ACCEL_NONE, name, "%g of %g pixels differ", wrong, W * W);
+    }
     free_scene(&s);
 }
 
@@ -936,7 +947,7 @@ int main(void)
         test_watertight(0, 0);
         test_watertight(1, 1e4);
         test_watertight(0, 1e4);
-        test_tree_matches_loop();
+        test_tree_matches_loop("kd", 300000);
         return failures != 0;
     }
     test_vectors();
@@ -958,8 +969,12 @@ int main(void)
     test_watertight(0, 0);
     test_watertight(1, 1e4);
     test_sphere_clip();
-    test_tree_matches_loop();
-    test_tree_image();
+    test_tree_matches_loop("kd", 1000000);
+    test_tree_matches_loop("bvh", 300000);
+    test_tree_matches_loop("grid", 300000);
+    test_tree_image("kd");
+    test_tree_image("bvh");
+    test_tree_image("grid");
     test_tir();
     test_budget();
     test_float_range();

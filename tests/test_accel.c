@@ -1,19 +1,23 @@
-/* test_kdtree.c - kd_nearest and kd_any against a brute-force loop.
+/* test_accel.c - every acceleration structure against a brute-force loop.
  *
- *     test_kdtree SCENE [RAYS]
+ *     test_accel STRUCTURE SCENE [RAYS]
  *
- * SCENE is one of: soup mesh grid thirds same flat empty one.  Prints one line per
- * check, "PASS ..." or "FAIL ...", and exits 1 if any check failed.  RAYS
- * (default 1000000, or $KD_RAYS) rays are shot per scene; each must give the
- * same primitive and bitwise the same t as the loop
+ * STRUCTURE is kd (kdtree.c), bvh-sah or bvh-median (bvh.c, its two builds)
+ * or grid (grid.c); SCENE is one of: soup mesh grid thirds same flat empty
+ * one.  Prints one line per check, "PASS ..." or "FAIL ...", and exits 1 if
+ * any check failed.  RAYS (default 1000000, or $ACCEL_RAYS) rays are shot per
+ * scene; each must give the same primitive and bitwise the same t as the loop
  *     for i in 0..n-1: if hit(i, tmin, best_t) and t < best_t: best = i
- * (a tie in t keeps the lower index), and kd_any (on every other ray) must
- * agree with a loop that stops at the first hit, and return a primitive
- * that is hit in range.  Every one of these queries is asked again of
- * kd_intersect_recursive, the slide's recursive TreeIntersect, which must
- * give what kd_nearest and kd_any give: the same primitive, bitwise the same
- * t, and the same numbers of steps and tests.  For long runs: $KD_SCALE
- * multiplies the scenes' sizes, $KD_SEED picks other random scenes and rays.
+ * (a tie in t keeps the lower index), and the any-hit query (on every other
+ * ray) must agree with a loop that stops at the first hit, and return a
+ * primitive that is hit in range.  For the kd-tree and the BVH every one of
+ * these queries is asked again of the slide's recursive form
+ * (kd_intersect_recursive, bvh_intersect_recursive), which must give what
+ * the iterative walk gives: the same primitive, bitwise the same t, and the
+ * same numbers of steps and tests.  The BVH is also refitted after a quarter
+ * of the primitives move, and checked again, against brute force and against
+ * a fresh build.  For long runs: $ACCEL_SCALE multiplies the scenes' sizes,
+ * $ACCEL_SEED picks other random scenes and rays.
  *
  * The test scenes put their vertices on coarse dyadic grids, and most
  * degenerate rays use grid origins and small directions, so that the
@@ -22,6 +26,8 @@
  * planes then meet the geometry exactly, which is where trees go wrong.
  */
 #include "../kdtree.h"
+#include "../bvh.h"
+#include "../grid.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,7 +85,7 @@ static double triple(const double d[3], const double b[3], const double c[3])
     return dot(d, bc);
 }
 
-/* Scenes are this many times their usual size ($KD_SCALE, for long runs). */
+/* Scenes are this many times their usual size ($ACCEL_SCALE, for long runs). */
 static double scale = 1;
 
 static unsigned long long rng_state = 88172645463325252ull;
@@ -332,7 +338,7 @@ static void make_mesh(scene *s)
  * two triangles each, some of them repeated: splits fall on lattice planes,
  * rays along lattice lines run along edges and through corners.  With step
  * 1 every coordinate is a float; with step 1/3 ("thirds") most are not, and
- * the tree's float planes and boxes round them (see kd_box in kdtree.c). */
+ * the tree's float planes and boxes round them (see kd_box in kdtree.c; the BVH rounds its boxes outwards). */
 static void make_grid(scene *s, double step)
 {
     int q, nq = (int)(120 * scale), k = 0;
@@ -666,9 +672,93 @@ static void show_mismatch(const char *what, int kind, const ray *r, double tmin,
             a, want, wt, b, got, gt);
 }
 
-/* Shape of the tree, and the 8-byte node: the block kd_bytes returns is
+/* ---- the structures under test ------------------------------------------ */
+
+/* Every check below runs on each structure, through these few switches. */
+enum { KD, BVH_SAH_BUILD, BVH_MEDIAN_BUILD, GRID };
+static const char *const accel_names[] = { "kd", "bvh-sah", "bvh-median", "grid" };
+
+typedef struct {
+    const char *name;
+    int kind;
+} accel;
+
+static void *build(const accel *A, int n, const prims *p)
+{
+    switch (A->kind) {
+    case KD: return kd_build(n, p);
+    case GRID: return grid_build(n, p);
+    }
+    return bvh_build(n, p, A->kind == BVH_SAH_BUILD ? BVH_SAH : BVH_MEDIAN);
+}
+
+static int nearest(const accel *A, const void *t, const prims *p, const ray *r, int skip,
+                   double tmin, double *tmax, prim_counters *c)
+{
+    void *rv = (void *)r;
+    if (A->kind == KD) return kd_nearest(t, p, r->o, r->d, rv, skip, tmin, tmax, c);
+    if (A->kind == GRID) return grid_nearest(t, p, r->o, r->d, rv, skip, tmin, tmax, c);
+    return bvh_nearest(t, p, r->o, r->d, rv, skip, tmin, tmax, c);
+}
+
+static int any_hit(const accel *A, const void *t, const prims *p, const ray *r, int skip,
+                   double tmin, double tmax, prim_counters *c)
+{
+    void *rv = (void *)r;
+    if (A->kind == KD) return kd_any(t, p, r->o, r->d, rv, skip, tmin, tmax, c);
+    if (A->kind == GRID) return grid_any(t, p, r->o, r->d, rv, skip, tmin, tmax, c);
+    return bvh_any(t, p, r->o, r->d, rv, skip, tmin, tmax, c);
+}
+
+/* The slide's recursive form; the grid has none. */
+static int has_recursive(const accel *A) { return A->kind != GRID; }
+
+static int recursive(const accel *A, const void *t, const prims *p, const ray *r, int skip,
+                     double tmin, double *tmax, int any, prim_counters *c)
+{
+    return A->kind == KD
+        ? kd_intersect_recursive(t, p, r->o, r->d, (void *)r, skip, tmin, tmax, any, c)
+        : bvh_intersect_recursive(t, p, r->o, r->d, (void *)r, skip, tmin, tmax, any, c);
+}
+
+/* The built structure as one block of bytes. */
+static const void *bytes(const accel *A, const void *t, size_t *size)
+{
+    bvh_info b;
+    grid_info g;
+    if (A->kind == KD) return kd_bytes(t, size);
+    if (A->kind == GRID) {
+        grid_describe(t, &g);
+        *size = g.bytes;
+        return g.block;
+    }
+    bvh_describe(t, &b);
+    *size = b.bytes;
+    return b.block;
+}
+
+/* The planes of its cells or boxes: rays are aimed along them. */
+static long planes(const accel *A, const void *t, int *axis, double *pos, long max)
+{
+    switch (A->kind) {
+    case KD: return kd_splits(t, axis, pos, max);
+    case GRID: return grid_planes(t, axis, pos, max);
+    }
+    return bvh_planes(t, axis, pos, max);
+}
+
+static void release(const accel *A, void *t)
+{
+    if (A->kind == KD) kd_free(t);
+    else if (A->kind == GRID) grid_free(t);
+    else bvh_free(t);
+}
+
+/* ---- shape -------------------------------------------------------------- */
+
+/* The kd-tree's shape, and its 8-byte node: the block kd_bytes returns is
  * exactly 8 bytes per node plus one int per primitive reference. */
-static void check_shape(const scene *s, const kd_tree *t)
+static void check_kd_shape(const scene *s, const kd_tree *t)
 {
     kd_info in;
     char msg[400];
@@ -690,38 +780,101 @@ static void check_shape(const scene *s, const kd_tree *t)
     report(ok, msg, s->name, "tree");
 }
 
-static void check_determinism(const scene *s, const prims *p, const kd_tree *t)
+/* The BVH's shape: 128 bytes a four-way node, no more nodes than leaves,
+ * and every primitive in exactly one leaf: the list at the end of the block
+ * is a permutation of 0..n-1. */
+static void check_bvh_shape(const scene *s, const bvh *t)
 {
-    kd_tree *again = kd_build(s->n, p);
+    bvh_info in;
+    char msg[400];
+    size_t size;
+    const char *block;
+    const int *list;
+    char *seen = calloc(s->n + 1, 1);
+    int ok, i, once = 1;
+    bvh_describe(t, &in);
+    block = in.block, size = in.bytes;
+    if (!seen) exit(2);
+    ok = in.nodes <= in.leaves && (in.nodes > 0) == (s->n > 0) && in.prim_refs == s->n
+         && in.max_depth < 96 && size == in.bytes
+         && size == 128 * (size_t)in.nodes + sizeof(int) * (size_t)s->n;
+    list = (const int *)(block + size - sizeof(int) * (size_t)s->n);
+    for (i = 0; ok && i < s->n; i++) {
+        if (list[i] < 0 || list[i] >= s->n || seen[list[i]]) once = 0;
+        else seen[list[i]] = 1;
+    }
+    free(seen);
+    sprintf(msg, "%d prims, %ld nodes, %ld leaves, depth %ld, %.2f prims/leaf, "
+            "each primitive in one leaf: %s, %lu bytes (128 per four-way node), SAH %.2f "
+            "(binary %.2f), built in %.4f s", s->n, in.nodes, in.leaves, in.max_depth,
+            in.prims_per_leaf, once ? "yes" : "NO", (unsigned long)in.bytes,
+            in.sah_cost, in.sah_cost_binary, in.build_seconds);
+    report(ok && once, msg, s->name, "tree");
+}
+
+/* The grid's shape: res[0] res[1] res[2] cells, a 4-byte offset per cell
+ * and one more, then a 4-byte primitive number per reference. */
+static void check_grid_shape(const scene *s, const grid *g)
+{
+    grid_info in;
+    char msg[400];
+    size_t size;
+    int ok;
+    grid_describe(g, &in);
+    size = in.bytes;
+    ok = in.cells == (long)in.res[0] * in.res[1] * in.res[2] && size == in.bytes
+         && in.bytes == 4 * (size_t)(in.cells + 1) + sizeof(int) * (size_t)in.prim_refs
+         && in.prim_refs >= s->n;
+    sprintf(msg, "%d prims, %dx%dx%d cells (%ld empty), %ld refs (%.2f a primitive), "
+            "%lu bytes, built in %.4f s", s->n, in.res[0], in.res[1], in.res[2],
+            in.empty_cells, in.prim_refs, s->n ? (double)in.prim_refs / s->n : 0.0,
+            (unsigned long)in.bytes, in.build_seconds);
+    report(ok, msg, s->name, "grid");
+}
+
+static void check_shape(const accel *A, const scene *s, const void *t)
+{
+    if (A->kind == KD) check_kd_shape(s, t);
+    else if (A->kind == GRID) check_grid_shape(s, t);
+    else check_bvh_shape(s, t);
+}
+
+static void check_determinism(const accel *A, const scene *s, const prims *p,
+                              const void *t)
+{
+    void *again = build(A, s->n, p);
     size_t n1, n2;
-    const void *b1 = kd_bytes(t, &n1), *b2;
+    const void *b1 = bytes(A, t, &n1), *b2;
     char msg[200];
     int ok;
     if (!again) {
         report(0, "second build failed", s->name, "deterministic");
         return;
     }
-    b2 = kd_bytes(again, &n2);
+    b2 = bytes(A, again, &n2);
     ok = n1 == n2 && memcmp(b1, b2, n1) == 0;
     sprintf(msg, "two builds, %lu and %lu bytes, %s", (unsigned long)n1,
             (unsigned long)n2, ok ? "identical" : "DIFFERENT");
     report(ok, msg, s->name, "deterministic");
-    kd_free(again);
+    release(A, again);
 }
 
-static splits get_splits(const kd_tree *t)
+/* The planes of the structure's cells or boxes: rays are aimed along them. */
+static splits get_splits(const accel *A, const void *t)
 {
     splits sp;
-    sp.n = kd_splits(t, NULL, NULL, 0);
+    sp.n = planes(A, t, NULL, NULL, 0);
     sp.axis = malloc((sp.n + 1) * sizeof(int));
     sp.pos = malloc((sp.n + 1) * sizeof(double));
     if (!sp.axis || !sp.pos) exit(2);
-    kd_splits(t, sp.axis, sp.pos, sp.n);
+    planes(A, t, sp.axis, sp.pos, sp.n);
     return sp;
 }
 
-/* The tmax for kd_any: unbounded, exactly at the nearest hit (the bound is
- * inclusive), just before it, or anywhere. */
+/* ---- rays ----------------------------------------------------------------- */
+
+/* The tmax for the any-hit query: unbounded, exactly at the nearest hit
+ * (the bound is inclusive), just before it, or anywhere. */
 static double any_tmax(int nearest, double t, double tmax)
 {
     switch (rnd() % 4) {
@@ -732,9 +885,9 @@ static double any_tmax(int nearest, double t, double tmax)
     }
 }
 
-/* One ray's nearest-hit check with primitive `skip` left out: 1 if the tree
- * agrees with the loop; want, want_t: the loop's answer. */
-static int check_nearest(const scene *s, const prims *p, const kd_tree *t,
+/* One ray's nearest-hit check with primitive `skip` left out: 1 if the
+ * structure agrees with the loop; want, want_t: the loop's answer. */
+static int check_nearest(const accel *A, const scene *s, const prims *p, const void *t,
                          const ray *r, int kind, int skip, double tmin, double tmax,
                          long k, int *want, double *want_t, prim_counters *c)
 {
@@ -742,43 +895,42 @@ static int check_nearest(const scene *s, const prims *p, const kd_tree *t,
     int got;
     *want_t = tmax;
     *want = reference_nearest(s, r, skip, tmin, want_t, k);
-    got = kd_nearest(t, p, r->o, r->d, (void *)r, skip, tmin, &got_t, c);
+    got = nearest(A, t, p, r, skip, tmin, &got_t, c);
     if (*want == got && !memcmp(want_t, &got_t, sizeof(double))) return 1;
     show_mismatch(skip < 0 ? "nearest" : "nearest with skip", kind, r, tmin, tmax,
-                  "brute", *want, *want_t, "tree", got, got_t);
+                  "brute", *want, *want_t, A->name, got, got_t);
     return 0;
 }
 
-static int check_any(const scene *s, const prims *p, const kd_tree *t,
+static int check_any(const accel *A, const scene *s, const prims *p, const void *t,
                      const ray *r, int kind, int skip, double tmin, double tmax,
                      long k, int *want, prim_counters *c)
 {
     int got;
     double tg;
     *want = reference_any(s, r, skip, tmin, tmax, k);
-    got = kd_any(t, p, r->o, r->d, (void *)r, skip, tmin, tmax, c);
+    got = any_hit(A, t, p, r, skip, tmin, tmax, c);
     /* any primitive hit in range will do, but it must be one */
     if (*want == (got >= 0) && (got < 0 || (got != skip && got < s->n
                                               && test_prim(s, got, r, tmin, tmax, &tg))))
         return 1;
     show_mismatch(skip < 0 ? "any" : "any with skip", kind, r, tmin, tmax,
-                  "brute", *want, 0, "tree", got, 0);
+                  "brute", *want, 0, A->name, got, 0);
     return 0;
 }
 
-/* One query (nearest, or any with `any`) asked of the walk (kd_nearest,
- * kd_any) and of the recursive reference: 1 if they give the same
- * primitive, bitwise the same t, and the same steps and tests. */
-static int check_recursive(const prims *p, const kd_tree *t, const ray *r,
+/* One query (nearest, or any with `any`) asked of the iterative walk and
+ * of the recursive reference: 1 if they give the same primitive, bitwise
+ * the same t, and the same steps and tests. */
+static int check_recursive(const accel *A, const prims *p, const void *t, const ray *r,
                            int kind, int skip, double tmin, double tmax, int any)
 {
     prim_counters cw = {0, 0, 0}, cr = {0, 0, 0};
     double tw = tmax, tr = tmax;
     char a[80], b[80];
-    int w = any ? kd_any(t, p, r->o, r->d, (void *)r, skip, tmin, tmax, &cw)
-                : kd_nearest(t, p, r->o, r->d, (void *)r, skip, tmin, &tw, &cw);
-    int k = kd_intersect_recursive(t, p, r->o, r->d, (void *)r, skip, tmin, &tr,
-                                   any, &cr);
+    int w = any ? any_hit(A, t, p, r, skip, tmin, tmax, &cw)
+                : nearest(A, t, p, r, skip, tmin, &tw, &cw);
+    int k = recursive(A, t, p, r, skip, tmin, &tr, any, &cr);
     if (w == k && !memcmp(&tw, &tr, sizeof tw) && cw.steps == cr.steps
         && cw.tests == cr.tests)
         return 1;
@@ -789,102 +941,188 @@ static int check_recursive(const prims *p, const kd_tree *t, const ray *r,
     return 0;
 }
 
-/* Every ray: kd_nearest.  Every other ray: kd_any.  Every 8th ray, once
- * more with its nearest primitive skipped (the surface a ray leaves, in
- * ray.c): nearest on odd rays, any on even ones.  Each of these queries is
- * also asked of the recursive reference (check_recursive). */
-static void check_rays(const scene *s, const prims *p, const kd_tree *t, long nrays)
+/* Every ray: nearest.  Every other ray: any.  Every 8th ray, once more with
+ * its nearest primitive skipped (the surface a ray leaves, in ray.c):
+ * nearest on odd rays, any on even ones.  Each of these queries is also
+ * asked of the recursive reference, where there is one.  `when` names the
+ * state checked ("" or "after refit"). */
+static void check_rays(const accel *A, const scene *s, const prims *p, const void *t,
+                       long nrays, const char *when)
 {
     box3 b;
-    splits sp = get_splits(t);
+    splits sp = get_splits(A, t);
     prim_counters c = {0, 0, 0};
     long k, bad_near = 0, bad_any = 0, bad_skip = 0, hits = 0, anys = 0, anyrays = 0;
     long skips = 0, rec_near = 0, rec_any = 0, bad_rec_near = 0, bad_rec_any = 0;
     long per_kind[KINDS] = {0}, bad_kind[KINDS] = {0};
-    char msg[600], *m = msg;
+    char msg[700], *m = msg, what[64];
     clock_t start = clock();
-    int j;
+    int j, rec = has_recursive(A);
     scene_box(s, &b);
     for (k = 0; k < nrays; k++) {
         ray r;
         double tmin, tmax, want_t, w2_t, ta;
         int kind = make_ray(s, &b, &sp, k, &r, &tmin, &tmax), want, w2, ok;
         per_kind[kind]++;
-        ok = check_nearest(s, p, t, &r, kind, -1, tmin, tmax, k, &want, &want_t, &c);
+        ok = check_nearest(A, s, p, t, &r, kind, -1, tmin, tmax, k, &want, &want_t, &c);
         hits += want >= 0;
         if (!ok) bad_near++, bad_kind[kind]++;
-        rec_near++, bad_rec_near += !check_recursive(p, t, &r, kind, -1, tmin, tmax, 0);
-        if (k % 8 == 1 && want >= 0) {
+        if (rec) rec_near++, bad_rec_near += !check_recursive(A, p, t, &r, kind, -1, tmin, tmax, 0);
+        if ((k % 8 == 1 || hits == 1) && want >= 0) {   /* the first hit, too: some scenes have few */
             skips++;
-            if (!check_nearest(s, p, t, &r, kind, want, tmin, tmax, k, &w2, &w2_t, &c))
+            if (!check_nearest(A, s, p, t, &r, kind, want, tmin, tmax, k, &w2, &w2_t, &c))
                 bad_skip++, bad_kind[kind]++;
-            rec_near++;
-            bad_rec_near += !check_recursive(p, t, &r, kind, want, tmin, tmax, 0);
+            if (rec) {
+                rec_near++;
+                bad_rec_near += !check_recursive(A, p, t, &r, kind, want, tmin, tmax, 0);
+            }
         }
-        if (k % 2) continue;  /* kd_any on every other ray */
+        if (k % 2) continue;  /* any-hit on every other ray */
         anyrays++;
         ta = any_tmax(want, want_t, tmax);
         if (k % 8 == 2 && want >= 0) {
             skips++;
-            if (!check_any(s, p, t, &r, kind, want, tmin, ta, k, &w2, &c))
+            if (!check_any(A, s, p, t, &r, kind, want, tmin, ta, k, &w2, &c))
                 bad_skip++, bad_kind[kind]++;
-            rec_any++, bad_rec_any += !check_recursive(p, t, &r, kind, want, tmin, ta, 1);
+            if (rec) {
+                rec_any++;
+                bad_rec_any += !check_recursive(A, p, t, &r, kind, want, tmin, ta, 1);
+            }
         }
-        ok = check_any(s, p, t, &r, kind, -1, tmin, ta, k, &w2, &c);
+        ok = check_any(A, s, p, t, &r, kind, -1, tmin, ta, k, &w2, &c);
         anys += w2;
         if (!ok) bad_any++, bad_kind[kind]++;
-        rec_any++, bad_rec_any += !check_recursive(p, t, &r, kind, -1, tmin, ta, 1);
+        if (rec) rec_any++, bad_rec_any += !check_recursive(A, p, t, &r, kind, -1, tmin, ta, 1);
     }
-    m += sprintf(m, "%ld rays, %ld hit, %ld mismatches; %.2f steps and %.2f "
-                 "tests per ray (brute force: %d); %.1f s; by kind:", nrays, hits,
-                 bad_near, (double)c.steps / c.rays, (double)c.tests / c.rays,
-                 s->n, (double)(clock() - start) / CLOCKS_PER_SEC);
+    m += sprintf(m, "%s%s%ld rays, %ld hit, %ld mismatches; %.2f steps and %.2f "
+                 "tests per ray (brute force: %d); %.1f s; by kind:", when, *when ? ": " : "",
+                 nrays, hits, bad_near, c.rays ? (double)c.steps / c.rays : 0.0,
+                 c.rays ? (double)c.tests / c.rays : 0.0, s->n,
+                 (double)(clock() - start) / CLOCKS_PER_SEC);
     for (j = 0; j < KINDS; j++)
         m += sprintf(m, " %s %ld/%ld", kind_name[j], bad_kind[j], per_kind[j]);
+    sprintf(what, "%s nearest", A->name);
     report(bad_near == 0 && c.rays == (unsigned long long)(nrays + anyrays + skips), msg,
-           s->name, "nearest");
-    sprintf(msg, "%ld rays, %ld blocked, %ld mismatches%s", anyrays, anys, bad_any,
+           s->name, what);
+    sprintf(msg, "%s%s%ld rays, %ld blocked, %ld mismatches%s", when, *when ? ": " : "",
+            anyrays, anys, bad_any,
             strcmp(s->name, "same") ? "" : " (full loop on every 1000th ray)");
-    report(bad_any == 0, msg, s->name, "any");
-    sprintf(msg, "%ld rays again with their nearest primitive skipped (nearest and any), "
-            "%ld mismatches", skips, bad_skip);
-    report(bad_skip == 0 && (skips > 0 || hits == 0), msg, s->name, "skip");
-    sprintf(msg, "kd_intersect_recursive against the walk on every query above: "
-            "%ld nearest, %ld mismatches; %ld any, %ld mismatches (same primitive, "
-            "bitwise the same t, same steps and tests)", rec_near, bad_rec_near,
-            rec_any, bad_rec_any);
-    report(bad_rec_near == 0 && bad_rec_any == 0, msg, s->name, "recursive");
+    sprintf(what, "%s any", A->name);
+    report(bad_any == 0, msg, s->name, what);
+    sprintf(msg, "%s%s%ld rays again with their nearest primitive skipped (nearest and any), "
+            "%ld mismatches", when, *when ? ": " : "", skips, bad_skip);
+    sprintf(what, "%s skip", A->name);
+    report(bad_skip == 0 && (skips > 0 || hits == 0), msg, s->name, what);
+    if (rec) {
+        sprintf(msg, "%s%sthe recursive reference against the walk on every query above: "
+                "%ld nearest, %ld mismatches; %ld any, %ld mismatches (same primitive, "
+                "bitwise the same t, same steps and tests)", when, *when ? ": " : "",
+                rec_near, bad_rec_near, rec_any, bad_rec_any);
+        sprintf(what, "%s recursive", A->name);
+        report(bad_rec_near == 0 && bad_rec_any == 0, msg, s->name, what);
+    }
     free(sp.axis), free(sp.pos);
+}
+
+/* ---- refit ------------------------------------------------------------------ */
+
+/* A quarter of the primitives move by a step of up to 2 along each axis, on
+ * the scene's grid (so that the exact-arithmetic rays stay exact).  The
+ * identical triangles of "same" all move together: they stay identical, as
+ * reference_nearest assumes. */
+static void move_some(scene *s)
+{
+    int i, k, a, same = !strcmp(s->name, "same");
+    double off[3];
+    for (a = 0; a < 3; a++) off[a] = on_grid(-2, 2, s->grid > 0 ? s->grid : 0.5);
+    for (i = 0; i < s->n; i++) {
+        prim *q = &s->p[i];
+        if (!same && rnd() % 4) continue;
+        if (!same)
+            for (a = 0; a < 3; a++) off[a] = on_grid(-2, 2, s->grid > 0 ? s->grid : 0.5);
+        for (k = 0; k < (q->kind == TRI ? 3 : 1); k++)
+            for (a = 0; a < 3; a++) q->v[k][a] += off[a];
+    }
+}
+
+/* The BVH after the primitives move: refitted, it must still give exactly
+ * what brute force gives (check_rays on a quarter of the rays), and on
+ * every one of those rays what a fresh build of the moved scene gives. */
+static void check_refit(const accel *A, scene *s, const prims *p, void *t, long nrays)
+{
+    void *fresh;
+    box3 b;
+    splits sp;
+    long k, bad = 0;
+    char msg[400], what[64];
+    bvh_info before, after, rebuilt;
+    prim_counters cr = {0, 0, 0}, cf = {0, 0, 0};
+    bvh_describe(t, &before);
+    move_some(s);
+    bvh_refit(t, p);
+    bvh_describe(t, &after);
+    check_rays(A, s, p, t, nrays / 4, "after refit");
+    fresh = build(A, s->n, p);
+    if (!fresh) exit(2);
+    scene_box(s, &b);
+    sp = get_splits(A, t);
+    for (k = 0; k < nrays / 4; k++) {
+        ray r;
+        double tmin, tmax, t1, t2;
+        int i1, i2;
+        make_ray(s, &b, &sp, k, &r, &tmin, &tmax);
+        t1 = t2 = tmax;
+        i1 = nearest(A, t, p, &r, -1, tmin, &t1, &cr);
+        i2 = nearest(A, fresh, p, &r, -1, tmin, &t2, &cf);
+        bad += i1 != i2 || memcmp(&t1, &t2, sizeof t1);
+    }
+    bvh_describe(fresh, &rebuilt);
+    sprintf(msg, "a quarter of the primitives moved, the tree refitted: SAH cost %.2f -> %.2f "
+            "(a fresh build: %.2f); on %ld rays, %.2f steps and %.2f tests per ray (fresh build: "
+            "%.2f and %.2f), %ld answers differ from the fresh build's", before.sah_cost,
+            after.sah_cost, rebuilt.sah_cost, nrays / 4, (double)cr.steps / (nrays / 4 ? nrays / 4 : 1),
+            (double)cr.tests / (nrays / 4 ? nrays / 4 : 1), (double)cf.steps / (nrays / 4 ? nrays / 4 : 1),
+            (double)cf.tests / (nrays / 4 ? nrays / 4 : 1), bad);
+    sprintf(what, "%s refit", A->name);
+    report(bad == 0, msg, s->name, what);
+    free(sp.axis), free(sp.pos);
+    release(A, fresh);
 }
 
 int main(int argc, char **argv)
 {
     scene s;
     prims p;
-    kd_tree *t;
+    void *t;
+    accel acc, *A = NULL;
     long nrays = 1000000;
-    const char *env = getenv("KD_RAYS");
+    int k;
+    const char *env = getenv("ACCEL_RAYS");
     if (env) nrays = atol(env);
-    env = getenv("KD_SEED");  /* other scenes and rays, for long runs */
+    env = getenv("ACCEL_SEED");  /* other scenes and rays, for long runs */
     if (env) rng_state += 0x9E3779B97F4A7C15ull * (unsigned long long)atol(env);
-    env = getenv("KD_SCALE");
+    env = getenv("ACCEL_SCALE");
     if (env) scale = atof(env);
     if (!(scale >= 0.1)) scale = 0.1;
-    if (argc > 2) nrays = atol(argv[2]);
-    if (argc < 2 || !make_scene(argv[1], &s)) {
-        fprintf(stderr, "usage: test_kdtree soup|mesh|grid|thirds|same|flat|empty|one [rays]\n");
+    if (argc > 3) nrays = atol(argv[3]);
+    for (k = 0; argc > 1 && k < 4; k++)
+        if (!strcmp(argv[1], accel_names[k])) acc.name = accel_names[k], acc.kind = k, A = &acc;
+    if (!A || argc < 3 || !make_scene(argv[2], &s)) {
+        fprintf(stderr, "usage: test_accel kd|bvh-sah|bvh-median|grid "
+                "soup|mesh|grid|thirds|same|flat|empty|one [rays]\n");
         return 2;
     }
     p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s;
-    t = kd_build(s.n, &p);
+    t = build(A, s.n, &p);
     if (!t) {
-        report(0, "kd_build returned NULL", s.name, "tree");
+        report(0, "the build returned NULL", s.name, A->name);
         return 1;
     }
-    check_shape(&s, t);
-    check_determinism(&s, &p, t);
-    check_rays(&s, &p, t, nrays);
-    kd_free(t);
+    check_shape(A, &s, t);
+    check_determinism(A, &s, &p, t);
+    check_rays(A, &s, &p, t, nrays, "");
+    if (A->kind == BVH_SAH_BUILD || A->kind == BVH_MEDIAN_BUILD) check_refit(A, &s, &p, t, nrays);
+    release(A, t);
     free(s.p);
     return failures != 0;
 }

@@ -1,0 +1,925 @@
+/* bvh.c - a bounding volume hierarchy for ray tracing over primitives it
+ * knows only through the callbacks of prims.h.  bvh.h maps the lecture's
+ * slide, BVH_Intersect(ray, node), to the functions below.
+ *
+ * Traversal: depth first, the nearer child first, the farther one on a
+ * stack, dropped when the ray enters its box beyond the nearest hit found
+ * meanwhile.  Each primitive sits in exactly one leaf, so unlike the
+ * kd-tree no mailbox is needed.
+ *
+ * Build, two ways (bvh_build's method):
+ *   BVH_SAH     the surface area heuristic over binned centroids (Wald 2007,
+ *               "On fast construction of SAH-based bounding volume
+ *               hierarchies"): each node's primitives are counted into BINS
+ *               slabs of their centroids along each axis, and the K - 1
+ *               planes between slabs are priced by one sweep from each end.
+ *               O(N) per level, O(N log N) in all.
+ *   BVH_MEDIAN  half the primitives on each side, by their centroids along
+ *               the longest axis (the lecture's "mediana"); leaves of at most
+ *               MEDIAN_LEAF primitives.
+ * bvh_refit keeps the tree and recomputes its boxes bottom-up.
+ */
+#include "bvh.h"
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* The SAH cost model (Goldsmith & Salmon 1987; MacDonald & Booth 1990):
+ *     cost(split) = COST_STEP + COST_TEST * (A(L) nL + A(R) nR) / A(node)
+ *     cost(leaf)  = COST_TEST * n
+ * A is surface area: the chance that a ray through a box also passes
+ * through a box inside it is the ratio of their areas.  COST_STEP is one
+ * node visited (two boxes tested), COST_TEST one call of the hit callback.
+ * A node splits while splitting is cheaper, up to MAX_LEAF primitives,
+ * beyond which it always splits if it can.  The leaf size is thus the
+ * model's choice: 1 to 3 primitives on meshes (1.1 tests per ray on the
+ * 100k sphere).  COST_TEST 0.5, 1.5 and 2, and MAX_LEAF 4, were measured
+ * against 1 and 8 on that sphere: all within the noise (2% primary, 10%
+ * random rays), 0.5 testing half again as many triangles. */
+#define COST_STEP 1.0
+#define COST_TEST 1.0
+#define MAX_LEAF 8
+
+/* Wald 2007 bins centroids into 16 or 32 slabs per axis and finds the tree
+ * nearly as good as one from every candidate plane.  16 keeps a bin's
+ * record and the sweep in the first-level cache. */
+#define BINS 16
+
+/* The median build has no cost model; its leaves stop at this size. */
+#define MEDIAN_LEAF 2
+
+/* The SAH build splits by count (always halving) below this depth, so that
+ * the depth, and the traversal's stack, stay under STACK_SIZE whatever the
+ * input: 64 levels of SAH, then at most 31 more. */
+#define SAH_DEPTH 64
+#define STACK_SIZE 96
+
+/* The margin.  Boxes are floats rounded outwards, so each holds its
+ * primitives' double boxes whole.  The walk then treats every box as grown
+ * by delta = BVH_EPS * (largest coordinate of the scene and the ray origin)
+ * on every side, for two reasons.  The hit callback's point may lie outside
+ * the primitive's box by up to 1e-7 of that coordinate (prims.h).  And the
+ * slab test runs in float: b - o rounds by 2^-24 of |b - o| <= 2 * scale,
+ * d to float, 1/d and the product by 2^-24 each, so a computed crossing
+ * may be off by 4 * 2^-24 * 2 * scale = 4.8e-7 * scale in space.  Together
+ * 5.8e-7; 2^-20 = 9.5e-7 covers them with room.  The origin shifted by delta is rounded
+ * away from the box (see setup_ray), so its own rounding only adds margin.
+ * The float test is valid while the numbers stay well inside the float
+ * range (FAST_MAX below); other rays are answered by testing every
+ * primitive. */
+#define BVH_EPS (1.0 / 1048576.0)
+#define FAST_MAX 0x1p60
+#define FAST_MIN 0x1p-60
+
+/* ---- nodes ------------------------------------------------------------ */
+
+/* The build makes a binary tree of 32-byte nodes (bvh_node: a box as six
+ * floats, an index and a count); the walk reads a tree of four-way nodes
+ * made from it by collapsing (bvh_node4): each node holds the boxes of up to
+ * four children, stored axis by axis so that one loop over the four lanes
+ * tests all of them, and the compiler can run it as one vector operation
+ * per line.  128 bytes a node, two cache lines: box[lo/hi][axis][child] in
+ * 96 bytes, then each child's index and count.  A child with count > 0 is a
+ * leaf of `count` primitives listed from `index` in the tree's primitive
+ * list; count 0 and index > 0 is the four-way node `index` (the root, node
+ * 0, is no one's child); count 0 and index 0 is an empty lane, its box
+ * inside out (lo = +inf, hi = -inf) so that no ray enters it.  Measured on
+ * a 100k-triangle sphere, one thread, Embree's rays (bench/raybench.c
+ * accel): the binary walk took 8.2 steps a primary ray and ran 6.9 Mrays/s
+ * (random rays: 9.1 steps, 1.7 Mrays/s); the four-way walk 5.0 steps and
+ * 12.5 Mrays/s (5.4 steps, 3.2 Mrays/s).  Leaves are left as the binary
+ * build made them. */
+typedef struct {
+    float box[2][3];
+    uint32_t index, count;
+} bvh_node;
+
+typedef struct {
+    float box[2][3][4];
+    uint32_t index[4], count[4];
+} bvh_node4;
+
+typedef char bvh_node_must_be_32_bytes[sizeof(bvh_node) == 32 ? 1 : -1];
+typedef char bvh_node4_must_be_128_bytes[sizeof(bvh_node4) == 128 ? 1 : -1];
+
+struct bvh {
+    bvh_node4 *nodes;  /* nodes[0] the root; nnodes of them, then the list */
+    int *prims;        /* the leaves' primitive numbers */
+    long nnodes, nprims;
+    void *block;       /* the allocation behind nodes and prims */
+    size_t bytes;
+    double scale;      /* largest |coordinate| of the root's boxes */
+    bvh_info info;
+};
+
+/* ---- floats rounded one way --------------------------------------------- */
+
+/* A float at most x, and one at least x: x moved by 2^-23 of itself (more
+ * than a float step) before rounding to nearest, so the rounding cannot
+ * cross it.  A step or two looser than nextafterf, without a call. */
+static float down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? (float)(x - fabs(x) * 0x1p-23) : f;
+}
+
+static float up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? (float)(x + fabs(x) * 0x1p-23) : f;
+}
+
+/* ---- traversal ---------------------------------------------------------- */
+
+/* The ray as the slab test needs it.  For each axis, neg picks the box
+ * corner the ray meets first (from the sign bit, so -0 counts as negative
+ * like its 1/d = -inf).  on and of are the origin moved by delta: the near
+ * plane of a box grown by delta is at b - delta (b + delta for neg), and
+ * b - delta - o = b - (o + delta), so the test reads the plain box with a
+ * moved origin; of likewise for the far plane.  A zero component gives
+ * inv = +-inf: the ray is inside that slab for every t or for none; where
+ * 0 * inf makes NaN, the comparisons in enter read it as "inside". */
+typedef struct {
+    float on[3], of[3], inv[3];
+    int neg[3];
+    float tmin;
+    int skip;
+} bvh_ray;
+
+/* A child to visit: a node (count 0) or a leaf, and the t where the ray
+ * enters its box. */
+typedef struct {
+    uint32_t index, count;
+    float entry;
+} bvh_todo;
+
+/* The ray set up for the float slab test: 1, or 0 when its numbers leave
+ * the test's range (see BVH_EPS), or -1 for NaN or infinite input. */
+static int setup_ray(const bvh *t, const double org[3], const double dir[3],
+                     int skip, double tmin, bvh_ray *r)
+{
+    double scale = t->scale, dmax = 0, delta;
+    int a;
+    for (a = 0; a < 3; a++) {
+        double o = fabs(org[a]), d = fabs(dir[a]);
+        if (!(o <= DBL_MAX && d <= DBL_MAX)) return -1;
+        if (o > scale) scale = o;
+        if (d > dmax) dmax = d;
+    }
+    r->skip = skip;
+    if (!(scale <= FAST_MAX && scale >= FAST_MIN && dmax <= FAST_MAX && dmax >= FAST_MIN))
+        return 0;
+    delta = BVH_EPS * scale;
+    for (a = 0; a < 3; a++) {
+        int neg = signbit(dir[a]) != 0;
+        r->neg[a] = neg;
+        r->on[a] = neg ? down(org[a] - delta) : up(org[a] + delta);
+        r->of[a] = neg ? up(org[a] + delta) : down(org[a] - delta);
+        r->inv[a] = 1.0f / (float)dir[a];    /* +-inf for +-0 and tiny d */
+    }
+    r->tmin = down(tmin);
+    return 1;
+}
+
+/* Intersect(ray, object) for each primitive of a leaf.  Nearest: keep the
+ * lowest t, and on equal t the lower primitive number, as the brute-force
+ * loop would; the callback gets tmax = the best t so far, inclusive, so
+ * that it reports such ties.  Any-hit: the first hit will do. */
+static inline int test_leaf(const bvh *t, uint32_t first, uint32_t count, const prims *p,
+                            const bvh_ray *r, void *ray, double tmin, int any,
+                            double *best_t, int best, unsigned long long *tests)
+{
+    const int *list = t->prims + first;
+    uint32_t k;
+    for (k = 0; k < count; k++) {
+        int i = list[k];
+        double th;
+        if (i == r->skip) continue;
+        ++*tests;
+        if (!p->hit(p->user, i, ray, tmin, *best_t, &th)) continue;
+        if (any) return i;
+        if (th < *best_t || (th == *best_t && (best < 0 || i < best)))
+            *best_t = th, best = i;
+    }
+    return best;
+}
+
+/* Intersect_P(ray, box) for the four children of node nd at once: the
+ * slab test (Kay & Kajiya 1986) of each box grown by delta, between tmin
+ * and tmax, written so that NaN never excludes and so that the compiler
+ * can run the four lanes as one vector operation per line.  The children
+ * the ray enters go to out[], nearer first (on equal entries, the earlier
+ * lane first), with the t where it enters; returns how many, 0 to 4.  An
+ * empty lane's inside-out box is never entered. */
+static inline int children(const bvh_node4 *nd, const bvh_ray *r, float tmax,
+                           bvh_todo out[4])
+{
+    const float *nx = nd->box[r->neg[0]][0], *fx = nd->box[1 - r->neg[0]][0];
+    const float *ny = nd->box[r->neg[1]][1], *fy = nd->box[1 - r->neg[1]][1];
+    const float *nz = nd->box[r->neg[2]][2], *fz = nd->box[1 - r->neg[2]][2];
+    float t0[4], t1[4];
+    unsigned mask;
+    int k, j, n = 0;
+    for (k = 0; k < 4; k++) {
+        float ax = (nx[k] - r->on[0]) * r->inv[0], bx = (fx[k] - r->of[0]) * r->inv[0];
+        float ay = (ny[k] - r->on[1]) * r->inv[1], by = (fy[k] - r->of[1]) * r->inv[1];
+        float az = (nz[k] - r->on[2]) * r->inv[2], bz = (fz[k] - r->of[2]) * r->inv[2];
+        float lo = r->tmin, hi = tmax;
+        lo = ax > lo ? ax : lo, lo = ay > lo ? ay : lo, lo = az > lo ? az : lo;
+        hi = bx < hi ? bx : hi, hi = by < hi ? by : hi, hi = bz < hi ? bz : hi;
+        t0[k] = lo, t1[k] = hi;
+    }
+    mask = (unsigned)(t0[0] <= t1[0]) | (unsigned)(t0[1] <= t1[1]) << 1
+           | (unsigned)(t0[2] <= t1[2]) << 2 | (unsigned)(t0[3] <= t1[3]) << 3;
+    for (k = 0; mask; k++, mask >>= 1) {
+        if (!(mask & 1)) continue;
+        j = n++;
+        if (j > 0 && t0[k] < out[j - 1].entry) {   /* insertion sort, rarely past one */
+            do out[j] = out[j - 1];
+            while (--j > 0 && t0[k] < out[j - 1].entry);
+        }
+        out[j].index = nd->index[k], out[j].count = nd->count[k], out[j].entry = t0[k];
+    }
+    return n;
+}
+
+/* The slide's BVH_Intersect(ray, node), recursive.  The caller has already
+ * found that the ray enters the node's box (Intersect_P): children() for
+ * every node but the root, whose box is the whole scene.  A child is
+ * visited only if the ray still enters it no later than the best hit found
+ * in the nearer ones; any = 1 stops at the first hit. */
+static int bvh_intersect(const bvh *t, const prims *p, const bvh_ray *r,
+                         void *ray, double tmin, int any, bvh_todo node,
+                         double *best_t, int best, prim_counters *c)
+{
+    bvh_todo child[4];
+    int k, n;
+    c->steps++;
+    if (node.count)
+        return test_leaf(t, node.index, node.count, p, r, ray, tmin, any, best_t, best,
+                         &c->tests);
+    n = children(&t->nodes[node.index], r, up(*best_t), child);
+    for (k = 0; k < n; k++) {
+        if (k > 0 && !(child[k].entry <= up(*best_t))) break;
+        best = bvh_intersect(t, p, r, ray, tmin, any, child[k], best_t, best, c);
+        if (any && best >= 0) break;
+    }
+    return best;
+}
+
+/* The walk behind bvh_nearest (any = 0) and bvh_any (any = 1): the fast
+ * path, bvh_intersect with the recursion turned into a loop, the farther
+ * children waiting on a stack with the t where the ray enters them.  Same
+ * nodes, same order, same tests. */
+static int walk(const bvh *t, const prims *p, const bvh_ray *r, void *ray,
+                double tmin, int any, double *best_t, prim_counters *c)
+{
+    bvh_todo stack[3 * STACK_SIZE], node, child[4];
+    float tmax = up(*best_t);
+    unsigned long long steps = 0, tests = 0;
+    int n = 0, best = -1;
+    node.index = 0, node.count = 0;
+    for (;;) {
+        steps++;
+        if (node.count == 0) {
+            int k = children(&t->nodes[node.index], r, tmax, child);
+            while (k > 1) stack[n++] = child[--k];
+            if (k > 0) {
+                node = child[0];
+                continue;
+            }
+        } else {
+            int was = best;
+            best = test_leaf(t, node.index, node.count, p, r, ray, tmin, any, best_t, best,
+                             &tests);
+            if (best != was) {
+                if (any) break;
+                tmax = up(*best_t);
+            }
+        }
+        while (n > 0 && !(stack[n - 1].entry <= tmax)) n--;
+        if (n == 0) break;
+        node = stack[--n];
+    }
+    if (c) c->steps += steps, c->tests += tests;
+    return best;
+}
+
+/* The query shared by the three entry points. */
+static int query(const bvh *t, const prims *p, const double org[3],
+                 const double dir[3], void *ray, int skip, double tmin,
+                 double *best_t, int any, int recursive, prim_counters *c)
+{
+    bvh_ray r;
+    int a;
+    if (c) c->rays++;
+    if (!t || t->nnodes == 0 || !(tmin <= *best_t)) return -1;
+    a = setup_ray(t, org, dir, skip, tmin, &r);
+    if (a < 0) return -1;
+    if (a == 0) {
+        /* out of the float test's range (see BVH_EPS): every primitive */
+        unsigned long long tests = 0;
+        a = test_leaf(t, 0, (uint32_t)t->nprims, p, &r, ray, tmin, any, best_t, -1, &tests);
+        if (c) c->tests += tests;
+        return a;
+    }
+    if (recursive) {
+        prim_counters none = {0, 0, 0};
+        bvh_todo root = {0, 0, 0};
+        return bvh_intersect(t, p, &r, ray, tmin, any, root, best_t, -1, c ? c : &none);
+    }
+    return walk(t, p, &r, ray, tmin, any, best_t, c);
+}
+
+int bvh_nearest(const bvh *t, const prims *p, const double org[3],
+                const double dir[3], void *ray, int skip, double tmin,
+                double *tmax, prim_counters *c)
+{
+    double best_t = *tmax;
+    int i = query(t, p, org, dir, ray, skip, tmin, &best_t, 0, 0, c);
+    if (i >= 0) *tmax = best_t;
+    return i;
+}
+
+int bvh_any(const bvh *t, const prims *p, const double org[3],
+            const double dir[3], void *ray, int skip, double tmin, double tmax,
+            prim_counters *c)
+{
+    return query(t, p, org, dir, ray, skip, tmin, &tmax, 1, 0, c);
+}
+
+int bvh_intersect_recursive(const bvh *t, const prims *p, const double org[3],
+                            const double dir[3], void *ray, int skip,
+                            double tmin, double *tmax, int any,
+                            prim_counters *c)
+{
+    double best_t = *tmax;
+    int i = query(t, p, org, dir, ray, skip, tmin, &best_t, any, 1, c);
+    if (i >= 0 && !any) *tmax = best_t;
+    return i;
+}
+
+/* ---- boxes -------------------------------------------------------------- */
+
+typedef struct {
+    float lo[3], hi[3];
+} bvh_box;
+
+static void box_empty(bvh_box *b)
+{
+    int a;
+    for (a = 0; a < 3; a++) b->lo[a] = HUGE_VALF, b->hi[a] = -HUGE_VALF;
+}
+
+static void box_grow(bvh_box *b, const bvh_box *c)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        if (c->lo[a] < b->lo[a]) b->lo[a] = c->lo[a];
+        if (c->hi[a] > b->hi[a]) b->hi[a] = c->hi[a];
+    }
+}
+
+static double box_area(const bvh_box *b)
+{
+    double dx = (double)b->hi[0] - b->lo[0];
+    double dy = (double)b->hi[1] - b->lo[1];
+    double dz = (double)b->hi[2] - b->lo[2];
+    if (!(dx >= 0)) return 0;   /* empty */
+    return 2 * (dx * dy + dy * dz + dz * dx);
+}
+
+/* Primitive i's box from the callback, rounded outwards to floats: it holds
+ * the double box whole.  0 for NaN or lo > hi. */
+static int prim_box(const prims *p, int i, bvh_box *b)
+{
+    double lo[3], hi[3];
+    int a;
+    p->bounds(p->user, i, lo, hi);
+    for (a = 0; a < 3; a++) {
+        if (!(lo[a] <= hi[a])) return 0;
+        b->lo[a] = down(lo[a]);
+        b->hi[a] = up(hi[a]);
+    }
+    return 1;
+}
+
+static void node_box(bvh_node *nd, const bvh_box *b)
+{
+    memcpy(nd->box[0], b->lo, sizeof b->lo);
+    memcpy(nd->box[1], b->hi, sizeof b->hi);
+}
+
+static void node_to_box(const bvh_node *nd, bvh_box *b)
+{
+    memcpy(b->lo, nd->box[0], sizeof b->lo);
+    memcpy(b->hi, nd->box[1], sizeof b->hi);
+}
+
+/* ---- the builder -------------------------------------------------------- */
+
+/* A primitive as the build moves it: its box and its number, 32 bytes.
+ * The build reorders these records themselves, not indices to them, so
+ * that every pass over a node's primitives reads memory in order (Wald
+ * 2007 does the same).  Centroids are used doubled, lo + hi, which orders
+ * and bins them alike without a multiplication. */
+typedef struct {
+    float lo[3];
+    int id;
+    float hi[3];
+    float pad;
+} bvh_ref;
+
+typedef struct {
+    const prims *p;
+    int method;
+    bvh_ref *ref;
+    bvh_node *nodes;
+    long nnodes;
+    long max_depth, leaves;
+} bvh_builder;
+
+static float centroid2(const bvh_ref *r, int a) { return r->lo[a] + r->hi[a]; }
+
+static void grow_ref(bvh_box *box, bvh_box *cbox, const bvh_ref *r)
+{
+    int a;
+    for (a = 0; a < 3; a++) {
+        float c = centroid2(r, a);
+        box->lo[a] = r->lo[a] < box->lo[a] ? r->lo[a] : box->lo[a];
+        box->hi[a] = r->hi[a] > box->hi[a] ? r->hi[a] : box->hi[a];
+        cbox->lo[a] = c < cbox->lo[a] ? c : cbox->lo[a];
+        cbox->hi[a] = c > cbox->hi[a] ? c : cbox->hi[a];
+    }
+}
+
+/* The box of primitives first..first+n-1, and the box of their doubled
+ * centroids. */
+static void bounds_of(const bvh_builder *b, long first, long n, bvh_box *box,
+                      bvh_box *cbox)
+{
+    long k;
+    box_empty(box), box_empty(cbox);
+    for (k = first; k < first + n; k++) grow_ref(box, cbox, &b->ref[k]);
+}
+
+/* A node of n primitives gets BINS bins per axis, or n when fewer: a
+ * small node's sweep then costs in proportion to it. */
+static int bins_for(long n) { return n < BINS ? (int)n : BINS; }
+
+static int bin_of(float c, float lo, float k1, int nb)
+{
+    int i = (int)((c - lo) * k1);
+    return i < 0 ? 0 : i >= nb ? nb - 1 : i;
+}
+
+/* nb slabs per axis of the centroid box: 1/width, or 0 for a flat axis
+ * (everything in bin 0). */
+static float bin_scale(const bvh_box *cbox, int a, int nb)
+{
+    double ext = (double)cbox->hi[a] - cbox->lo[a];
+    return ext > 0 ? (float)(nb * (1 - 1e-6) / ext) : 0;
+}
+
+/* Wald 2007: one pass puts every primitive in a bin on each axis; then a
+ * sweep from each end prices the planes between bins.  Returns the
+ * best cost, its axis and the number of bins left of it; HUGE_VAL when no
+ * plane parts the primitives. */
+static double best_bin_split(const bvh_builder *b, long first, long n,
+                             const bvh_box *cbox, double area, int *axis,
+                             int *split)
+{
+    bvh_box bin[3][BINS], acc;
+    long count[3][BINS], k;
+    float k1[3];
+    double best = HUGE_VAL;
+    int a, i, nb = bins_for(n);
+    for (a = 0; a < 3; a++) {
+        k1[a] = bin_scale(cbox, a, nb);
+        for (i = 0; i < nb; i++) box_empty(&bin[a][i]), count[a][i] = 0;
+    }
+    for (k = first; k < first + n; k++) {
+        const bvh_ref *r = &b->ref[k];
+        for (a = 0; a < 3; a++) {
+            int j = bin_of(centroid2(r, a), cbox->lo[a], k1[a], nb), c;
+            bvh_box *x = &bin[a][j];
+            for (c = 0; c < 3; c++) {   /* min and max without a branch */
+                x->lo[c] = r->lo[c] < x->lo[c] ? r->lo[c] : x->lo[c];
+                x->hi[c] = r->hi[c] > x->hi[c] ? r->hi[c] : x->hi[c];
+            }
+            count[a][j]++;
+        }
+    }
+    for (a = 0; a < 3; a++) {
+        double right_area[BINS];
+        long right_n[BINS], nl = 0;
+        if (k1[a] == 0) continue;
+        box_empty(&acc);
+        for (i = nb - 1, k = 0; i > 0; i--) {     /* right of plane i: bins i.. */
+            box_grow(&acc, &bin[a][i]);
+            k += count[a][i];
+            right_area[i] = box_area(&acc), right_n[i] = k;
+        }
+        box_empty(&acc);
+        for (i = 1; i < nb; i++) {                /* plane i: bins 0..i-1 left */
+            double cost;
+            box_grow(&acc, &bin[a][i - 1]);
+            nl += count[a][i - 1];
+            if (nl == 0 || right_n[i] == 0) continue;
+            cost = COST_STEP + COST_TEST * (box_area(&acc) * nl + right_area[i] * right_n[i]) / area;
+            if (cost < best) best = cost, *axis = a, *split = i;
+        }
+    }
+    return best;
+}
+
+/* The two sides of a split: their boxes and centroid boxes. */
+typedef struct {
+    bvh_box box[2], cbox[2];
+} bvh_sides;
+
+/* Reorders the node's primitives so that those left of the plane come
+ * first, noting each side's boxes on the way; returns how many go left. */
+static long partition_bins(bvh_builder *b, long first, long n, const bvh_box *cbox,
+                           int axis, int split, bvh_sides *sd)
+{
+    int nb = bins_for(n);
+    float lo = cbox->lo[axis], k1 = bin_scale(cbox, axis, nb);
+    long i = first, j = first + n - 1;
+    box_empty(&sd->box[0]), box_empty(&sd->cbox[0]);
+    box_empty(&sd->box[1]), box_empty(&sd->cbox[1]);
+    while (i <= j) {
+        bvh_ref *r = &b->ref[i];
+        if (bin_of(centroid2(r, axis), lo, k1, nb) < split) {
+            grow_ref(&sd->box[0], &sd->cbox[0], r);
+            i++;
+        } else {
+            bvh_ref tmp = *r;
+            *r = b->ref[j], b->ref[j] = tmp;
+            grow_ref(&sd->box[1], &sd->cbox[1], &b->ref[j]);
+            j--;
+        }
+    }
+    return i - first;
+}
+
+/* Centroid order along an axis, ties by primitive number: a total order, so
+ * the median build is deterministic. */
+static int before(const bvh_ref *p, const bvh_ref *q, int axis)
+{
+    float cp = centroid2(p, axis), cq = centroid2(q, axis);
+    return cp < cq || (cp == cq && p->id < q->id);
+}
+
+static void swap_refs(bvh_ref *x, long i, long j)
+{
+    bvh_ref tmp = x[i];
+    x[i] = x[j], x[j] = tmp;
+}
+
+/* Hoare's selection (quickselect): the node's primitives reordered so that
+ * the m-th smallest is at first + m, smaller ones before it and larger
+ * after; expected O(n).  The pivot is the middle element, swapped to the
+ * end (Lomuto's partition). */
+static void select_nth(bvh_builder *b, long first, long n, long m, int axis)
+{
+    long lo = first, hi = first + n - 1, want = first + m;
+    bvh_ref *x = b->ref;
+    while (lo < hi) {
+        long k, store = lo;
+        swap_refs(x, lo + (hi - lo) / 2, hi);
+        for (k = lo; k < hi; k++)
+            if (before(&x[k], &x[hi], axis)) swap_refs(x, k, store++);
+        swap_refs(x, hi, store);
+        if (store == want) return;
+        if (store < want) lo = store + 1;
+        else hi = store - 1;
+    }
+}
+
+static int longest_axis(const bvh_box *b)
+{
+    double dx = (double)b->hi[0] - b->lo[0], dy = (double)b->hi[1] - b->lo[1];
+    double dz = (double)b->hi[2] - b->lo[2];
+    return dx >= dy ? (dx >= dz ? 0 : 2) : (dy >= dz ? 1 : 2);
+}
+
+/* Half the primitives each side, by centroid along the axis; the sides'
+ * boxes measured afresh. */
+static long split_median(bvh_builder *b, long first, long n, int axis, bvh_sides *sd)
+{
+    select_nth(b, first, n, n / 2, axis);
+    bounds_of(b, first, n / 2, &sd->box[0], &sd->cbox[0]);
+    bounds_of(b, first + n / 2, n - n / 2, &sd->box[1], &sd->cbox[1]);
+    return n / 2;
+}
+
+/* How many primitives of the node go left (and the sides' boxes in sd);
+ * 0 for a leaf. */
+static long choose_split(bvh_builder *b, long first, long n, int depth,
+                         const bvh_box *box, const bvh_box *cbox, bvh_sides *sd)
+{
+    int axis = longest_axis(cbox), split = 0;
+    double cost;
+    if (n <= 1 || !((double)cbox->hi[axis] - cbox->lo[axis] > 0))
+        return 0;   /* one primitive, or every centroid at one point */
+    if (b->method == BVH_MEDIAN || depth >= SAH_DEPTH) {
+        if (b->method == BVH_MEDIAN && n <= MEDIAN_LEAF) return 0;
+        return split_median(b, first, n, axis, sd);
+    }
+    cost = best_bin_split(b, first, n, cbox, box_area(box), &axis, &split);
+    if (cost == HUGE_VAL) return split_median(b, first, n, axis, sd);  /* all in one bin */
+    if (cost >= COST_TEST * n && n <= MAX_LEAF) return 0;
+    return partition_bins(b, first, n, cbox, axis, split, sd);
+}
+
+/* Node `at` over primitives first..first+n-1, whose boxes are box and
+ * (centroids) cbox. */
+static void build_node(bvh_builder *b, long at, long first, long n, int depth,
+                       const bvh_box *box, const bvh_box *cbox)
+{
+    bvh_sides sd;
+    long nl;
+    node_box(&b->nodes[at], box);
+    if (depth > b->max_depth) b->max_depth = depth;
+    nl = choose_split(b, first, n, depth, box, cbox, &sd);
+    if (nl == 0) {
+        b->nodes[at].index = (uint32_t)first, b->nodes[at].count = (uint32_t)n;
+        b->leaves++;
+        return;
+    }
+    b->nodes[at].index = (uint32_t)b->nnodes, b->nodes[at].count = 0;
+    b->nnodes += 2;
+    build_node(b, b->nodes[at].index, first, nl, depth + 1, &sd.box[0], &sd.cbox[0]);
+    build_node(b, b->nodes[at].index + 1, first + nl, n - nl, depth + 1, &sd.box[1], &sd.cbox[1]);
+}
+
+/* Expected cost of a ray that meets the root of the binary tree, by the SAH
+ * model. */
+static double tree_cost(const bvh_builder *b)
+{
+    bvh_box root, box;
+    double a0, sum = 0;
+    long i;
+    if (b->nnodes == 0) return 0;
+    node_to_box(&b->nodes[0], &root);
+    a0 = box_area(&root);
+    if (!(a0 > 0)) return 0;
+    for (i = 0; i < b->nnodes; i++) {
+        if (i == 1) continue;
+        node_to_box(&b->nodes[i], &box);
+        sum += box_area(&box) / a0 * (b->nodes[i].count ? COST_TEST * b->nodes[i].count : COST_STEP);
+    }
+    return sum;
+}
+
+/* ---- four-way nodes ------------------------------------------------------ */
+
+static void lane_box(bvh_node4 *nd, int k, const bvh_box *b)
+{
+    int a;
+    for (a = 0; a < 3; a++) nd->box[0][a][k] = b->lo[a], nd->box[1][a][k] = b->hi[a];
+}
+
+static void lane_to_box(const bvh_node4 *nd, int k, bvh_box *b)
+{
+    int a;
+    for (a = 0; a < 3; a++) b->lo[a] = nd->box[0][a][k], b->hi[a] = nd->box[1][a][k];
+}
+
+static int lane_empty(const bvh_node4 *nd, int k)
+{
+    return nd->count[k] == 0 && nd->index[k] == 0;
+}
+
+/* The up to four binary nodes that one four-way node holds in place of the
+ * binary inner node `bin`: its two children, then, while there are fewer
+ * than four, the inner one of largest area replaced by its own two (the
+ * order of the lanes kept). */
+static int gather_lanes(const bvh_node *bin, uint32_t at, uint32_t lane[4])
+{
+    int n = 2, k;
+    lane[0] = bin[at].index, lane[1] = lane[0] + 1;
+    while (n < 4) {
+        int pick = -1;
+        double most = -1;
+        bvh_box box;
+        for (k = 0; k < n; k++) {
+            if (bin[lane[k]].count) continue;
+            node_to_box(&bin[lane[k]], &box);
+            if (box_area(&box) > most) most = box_area(&box), pick = k;
+        }
+        if (pick < 0) break;
+        for (k = n; k > pick + 1; k--) lane[k] = lane[k - 1];
+        lane[pick + 1] = bin[lane[pick]].index + 1;
+        lane[pick] = bin[lane[pick]].index;
+        n++;
+    }
+    return n;
+}
+
+/* Four-way node number *used (then *used + 1) from binary node `at`, and
+ * below it; returns its number.  Parents come before their children. */
+static uint32_t collapse(const bvh_node *bin, uint32_t at, bvh_node4 *out, long *used,
+                         int depth, long *max_depth)
+{
+    uint32_t lane[4], me = (uint32_t)(*used)++;
+    int n = bin[at].count ? 1 : gather_lanes(bin, at, lane), k;
+    bvh_box box;
+    if (bin[at].count) lane[0] = at;   /* a leaf as the root */
+    if (depth > *max_depth) *max_depth = depth;
+    box_empty(&box);
+    for (k = 0; k < 4; k++) {
+        out[me].index[k] = out[me].count[k] = 0;
+        lane_box(&out[me], k, &box);
+    }
+    for (k = 0; k < n; k++) {
+        const bvh_node *b = &bin[lane[k]];
+        node_to_box(b, &box);
+        lane_box(&out[me], k, &box);
+        out[me].count[k] = b->count;
+        out[me].index[k] = b->count ? b->index
+                                    : collapse(bin, lane[k], out, used, depth + 1, max_depth);
+    }
+    return me;
+}
+
+/* The SAH model's expected cost of the four-way tree for a ray that meets
+ * the scene box: each lane's area over the scene box's, times COST_STEP for
+ * a node (its four boxes tested) or COST_TEST per primitive of a leaf.  It
+ * shows what a refit costs as objects move. */
+static double tree_cost4(const bvh *t)
+{
+    bvh_box root, box;
+    double a0, sum = 0;
+    long i;
+    int k;
+    if (t->nnodes == 0) return 0;
+    box_empty(&root);
+    for (k = 0; k < 4; k++) lane_to_box(&t->nodes[0], k, &box), box_grow(&root, &box);
+    a0 = box_area(&root);
+    if (!(a0 > 0)) return 0;
+    sum = COST_STEP;
+    for (i = 0; i < t->nnodes; i++)
+        for (k = 0; k < 4; k++) {
+            const bvh_node4 *nd = &t->nodes[i];
+            if (lane_empty(nd, k)) continue;
+            lane_to_box(nd, k, &box);
+            sum += box_area(&box) / a0 * (nd->count[k] ? COST_TEST * nd->count[k] : COST_STEP);
+        }
+    return sum;
+}
+
+static void set_scale(bvh *t)
+{
+    int a, s, k;
+    t->scale = 0;
+    if (t->nnodes == 0) return;
+    for (k = 0; k < 4; k++)
+        for (s = 0; s < 2; s++)
+            for (a = 0; a < 3; a++) {
+                float x = t->nodes[0].box[s][a][k];
+                if (!lane_empty(&t->nodes[0], k) && fabs(x) > t->scale) t->scale = fabs(x);
+            }
+}
+
+/* The tree in one block, the nodes aligned to 64 bytes. */
+static bvh *alloc_tree(long nnodes, long nprims)
+{
+    bvh *t = calloc(1, sizeof *t);
+    size_t nb = (size_t)nnodes * sizeof(bvh_node4), pb = (size_t)nprims * sizeof(int);
+    if (!t) return NULL;
+    t->block = calloc(1, nb + pb + 64);
+    if (!t->block) return free(t), NULL;
+    t->nodes = (bvh_node4 *)((char *)t->block + (64 - (uintptr_t)t->block % 64) % 64);
+    t->prims = (int *)(t->nodes + nnodes);
+    t->nnodes = nnodes, t->nprims = nprims;
+    t->bytes = nb + pb;
+    return t;
+}
+
+/* The binary tree collapsed to four-way nodes: at most one per binary
+ * inner node, or one for a root that is a leaf. */
+static bvh *finish(bvh_builder *b, const int *ids, long nprims)
+{
+    long inner = b->nnodes ? (b->nnodes - 1 - b->leaves) : 0, used = 0, depth = 0;
+    bvh *t = alloc_tree(b->nnodes ? (inner > 0 ? inner : 1) : 0, nprims);
+    if (!t) return NULL;
+    if (b->nnodes) collapse(b->nodes, 0, t->nodes, &used, 0, &depth);
+    t->nnodes = used;
+    t->bytes = (size_t)used * sizeof(bvh_node4) + (size_t)nprims * sizeof(int);
+    if (nprims) memcpy(t->nodes + used, ids, (size_t)nprims * sizeof(int));
+    t->prims = (int *)(t->nodes + used);
+    set_scale(t);
+    t->info.nodes = used;
+    t->info.leaves = b->leaves;
+    t->info.max_depth = depth;
+    t->info.prim_refs = nprims;
+    t->info.prims_per_leaf = b->leaves ? (double)nprims / b->leaves : 0;
+    t->info.bytes = t->bytes;
+    t->info.sah_cost = tree_cost4(t);
+    t->info.sah_cost_binary = tree_cost(b);
+    return t;
+}
+
+/* A record for every primitive with a box; returns how many. */
+static long gather(bvh_builder *b, int n)
+{
+    long m = 0;
+    int i;
+    for (i = 0; i < n; i++) {
+        bvh_box box;
+        if (!prim_box(b->p, i, &box)) continue;
+        memcpy(b->ref[m].lo, box.lo, sizeof box.lo);
+        memcpy(b->ref[m].hi, box.hi, sizeof box.hi);
+        b->ref[m].id = i, b->ref[m].pad = 0;
+        m++;
+    }
+    return m;
+}
+
+bvh *bvh_build(int n, const prims *p, int method)
+{
+    clock_t start = clock();
+    bvh_builder b;
+    bvh *t = NULL;
+    int *ids;
+    long m, k;
+    memset(&b, 0, sizeof b);
+    b.p = p, b.method = method;
+    if (n < 0) n = 0;
+    b.ref = malloc(((size_t)n + 1) * sizeof *b.ref);
+    b.nodes = calloc(2 * (size_t)n + 2, sizeof *b.nodes);
+    ids = malloc(((size_t)n + 1) * sizeof *ids);
+    if (b.ref && b.nodes && ids) {
+        m = gather(&b, n);
+        if (m > 0) {
+            bvh_box box, cbox;
+            bounds_of(&b, 0, m, &box, &cbox);
+            b.nnodes = 2;   /* the root, and the padding that aligns the pairs */
+            build_node(&b, 0, 0, m, 0, &box, &cbox);
+        }
+        for (k = 0; k < m; k++) ids[k] = b.ref[k].id;
+        t = finish(&b, ids, m);
+    }
+    free(b.ref), free(b.nodes), free(ids);
+    if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
+    return t;
+}
+
+/* Children come after their parent in the array, so one pass from the end
+ * sees every child before its parent. */
+void bvh_refit(bvh *t, const prims *p)
+{
+    long i;
+    if (!t) return;
+    for (i = t->nnodes - 1; i >= 0; i--) {
+        bvh_node4 *nd = &t->nodes[i];
+        int k, j;
+        for (k = 0; k < 4; k++) {
+            bvh_box box, c;
+            uint32_t m;
+            if (lane_empty(nd, k)) continue;
+            box_empty(&box);
+            for (m = 0; m < nd->count[k]; m++)
+                if (prim_box(p, t->prims[nd->index[k] + m], &c)) box_grow(&box, &c);
+            for (j = 0; nd->count[k] == 0 && j < 4; j++) {
+                lane_to_box(&t->nodes[nd->index[k]], j, &c);
+                box_grow(&box, &c);
+            }
+            lane_box(nd, k, &box);
+        }
+    }
+    set_scale(t);
+    t->info.sah_cost = tree_cost4(t);
+}
+
+void bvh_describe(const bvh *t, bvh_info *info)
+{
+    memset(info, 0, sizeof *info);
+    if (!t) return;
+    *info = t->info;
+    info->block = t->nodes;
+}
+
+void bvh_free(bvh *t)
+{
+    if (t) free(t->block), free(t);
+}
+
+long bvh_planes(const bvh *t, int *axis, double *pos, long max)
+{
+    long i, n = 0;
+    int s, a, k;
+    for (i = 0; i < t->nnodes; i++)
+        for (k = 0; k < 4; k++)
+            for (s = 0; s < 2 && !lane_empty(&t->nodes[i], k); s++)
+                for (a = 0; a < 3; a++) {
+                    if (n < max) axis[n] = a, pos[n] = t->nodes[i].box[s][a][k];
+                    n++;
+                }
+    return n;
+}
