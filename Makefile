@@ -47,7 +47,7 @@ test: all
 stress: all spd
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/stress.sh
 
-bench: all
+bench: all spd
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash bench/run.sh
 
 clean:

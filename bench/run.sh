@@ -51,7 +51,8 @@
 #   BENCH_MINRAY_SIZE=512x512
 #   BENCH_THREADS=N          ./ray -t N in the render section (default:
 #                            ./ray's own, every core); the others use one
-#   BENCH_SPD_DIR=../shared/spd           the SPD scenes (and pov/)
+#   BENCH_SPD_DIR=scenes/spd              the SPD scenes (make spd writes them;
+#                                         POV-Ray's pov/ files: ../shared/spd)
 #   BENCH_SPD="balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11"
 #   BENCH_NONE_BUDGET=2      seconds one brute-force render may take: sets
 #                            each SPD scene's image size, from a 16x16 probe
@@ -88,7 +89,8 @@ FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
 PARTS=${BENCH_PARTS:-render spd build rays accel pov pt}
-SPD_DIR=${BENCH_SPD_DIR:-../shared/spd}
+SPD_DIR=${BENCH_SPD_DIR:-scenes/spd}
+POV_DIR=${BENCH_POV_DIR:-../shared/spd/pov}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
 NONE_BUDGET=${BENCH_NONE_BUDGET:-2}
 BUILD_MAX=${BENCH_BUILD_MAX:-1000000}
@@ -519,6 +521,11 @@ make_mesh() {
       python3 "$EMBREE_DIR/tools/gen_sphere.py" "$n" "$tmp" 2>>"$OUT/mesh.log" || { mesh_why="gen_sphere.py failed"; return 1; } ;;
     *)
       mesh_view=$SPD_DIR/$name.nff
+      # an SPD database at another size than make spd's: tools/spd makes it
+      if [ ! -f "$mesh_view" ] && [ -x tools/spd ] && [[ $name =~ ^([a-z]+)_s([0-9]+)$ ]]; then
+        tools/spd "${BASH_REMATCH[1]}" "${BASH_REMATCH[2]}" >"$mesh_view.tmp" 2>>"$OUT/mesh.log" \
+          && mv "$mesh_view.tmp" "$mesh_view"
+      fi
       [ -f "$mesh_view" ] || { mesh_why="$mesh_view not found"; return 1; }
       [ -f "$EMBREE_DIR/tools/nff2obj.py" ] || { mesh_why="$EMBREE_DIR/tools/nff2obj.py not found"; return 1; }
       python3 "$EMBREE_DIR/tools/nff2obj.py" "$mesh_view" "$tmp" 2>>"$OUT/mesh.log" || { mesh_why="nff2obj.py failed"; return 1; } ;;
@@ -828,11 +835,11 @@ if part pov; then
     pov_w=- pov_t=- pov_rays=-
     if [ -z "$povray_ok" ]; then
       pov_w="POV-Ray not installed, skipped"
-    elif [ ! -f "$SPD_DIR/pov/$pov.pov" ]; then
-      pov_w="$SPD_DIR/pov/$pov.pov not found, skipped"
+    elif [ ! -f "$POV_DIR/$pov.pov" ]; then
+      pov_w="$POV_DIR/$pov.pov not found, skipped"
     else
       say "pov: $pov: POV-Ray"
-      src=$(cd "$SPD_DIR/pov" && pwd)/$pov.pov
+      src=$(cd "$POV_DIR" && pwd)/$pov.pov
       if pov1 "$src" "$PWD/$OUT/pov-$pov.ppm" "$OUT/pov-$pov.log"; then
         pov_w=$took pov_t=$(pov_trace "$OUT/pov-$pov.log")
         if awk "BEGIN { exit !($took < 2) }"; then

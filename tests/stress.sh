@@ -3,8 +3,9 @@
 # structure (kd, bvh-sah, bvh-median, grid) against brute force on 10^6 rays
 # per scene, and again at 4x the scene sizes with two more seeds; every SPD
 # scene (make spd) rendered with each of --accel kd, bvh, grid and none, the
-# same bytes; the same output from 1, 2 and 3 threads on every SPD scene of
-# ../shared, when it is there.  Ends with "N passed, N failed" like make test.
+# same bytes; the same output from 1, 2 and 3 threads on every SPD scene
+# (those make spd writes; SPD=DIR for others).  Ends with "N passed, N
+# failed" like make test.
 cd "$(dirname "$0")/.." || exit 2
 . tests/lib.sh
 pass=0 fail=0
@@ -41,7 +42,7 @@ for f in scenes/spd/*.nff; do
     || echo "FAIL $n: the structures' pictures differ"
 done > "$TMP/spd_acc.all"
 count < "$TMP/spd_acc.all"
-spd=${SPD:-../shared/spd}
+spd=${SPD:-scenes/spd}
 if [ -d "$spd" ]; then
   for f in "$spd"/*.nff; do
     n=$(basename "$f" .nff)
