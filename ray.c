@@ -775,16 +775,18 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
 /* Le: what the hit object emits towards wo (kl times its colour; a sphere
  * from both sides, a one-sided triangle from its front only), weighed for
  * the estimator: NEE has counted it already unless the ray came from the
- * camera, a mirror or glass; MIS weighs it against sample_light's pdf. */
+ * camera, a mirror or glass; MIS weighs it against sample_light's pdf.  An
+ * object that glows but is no light sample_light can choose (a cone, a
+ * degenerate triangle) counts in full whatever the estimator. */
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path)
 {
     const Material *m = &s->mat[h->mat];
+    int l = s->emitter[h->obj];
     real w = 1;
     if (!(m->kl > 0) || !front_emits(s, h->obj, h->ng, wo)) return v3(0, 0, 0);
-    if (!path->counted && s->estimator == NEE) return v3(0, 0, 0);
-    if (!path->counted && s->estimator == MIS)
-        w = power_heuristic(path->pdf, light_pdf(s, s->emitter[h->obj], path->from,
-                                                 path->n_from, h->p, h->ng));
+    if (!path->counted && l >= 0 && s->estimator == NEE) return v3(0, 0, 0);
+    if (!path->counted && l >= 0 && s->estimator == MIS)
+        w = power_heuristic(path->pdf, light_pdf(s, l, path->from, path->n_from, h->p, h->ng));
     return scale(w * m->kl, m->color);
 }
 

@@ -542,6 +542,36 @@ static void test_estimators_agree(void)
     for (e = 0; e < 3; e++) free_scene(&s[e]);
 }
 
+/* A cone that glows is no light sample_light can choose, so whatever the
+ * estimator, its light is found by BSDF sampling alone and counts in full:
+ * all three must agree on a ball lit by it (NEE used to drop it, MIS to
+ * read a light that does not exist).  Means within K standard errors of
+ * their difference. */
+static void test_glowing_cone(void)
+{
+    Stat st[3];
+    int e, ok = 1;
+    for (e = 0; e < 3; e++) {
+        Scene s;
+        default_scene(&s);
+        s.w = s.h = 8;
+        add_cone(&s, v3(0, 0, -1), 0.5, v3(0, 0, 1), 0.5, material(&s, v3(1, 1, 1), 0, 0, 0, 2, 1, 0));
+        add_sphere(&s, v3(0, 0, -3), 1.5, material(&s, v3(1, 1, 1), 0.8, 0, 0, 0, 1, 0));
+        camera(&s, v3(0, -5, 0), v3(0, 0, -1), v3(0, 0, 1), 40);
+        ready(&s, e, 1, 0);
+        st[e] = image_samples(&s, 20000, 0);
+        free_scene(&s);
+    }
+    for (e = 0; e < 3; e++) {
+        const Stat *a = &st[e], *b = &st[(e + 1) % 3];
+        ok = ok && fabs(stat_mean(a) - stat_mean(b))
+                       <= K * sqrt(stat_se(a) * stat_se(a) + stat_se(b) * stat_se(b));
+    }
+    report(ok, "a glowing cone (no light to sample) lights a ball the same for every estimator",
+           "bsdf %.4f, nee %.4f, mis %.4f (+- %.4f)", stat_mean(&st[0]), stat_mean(&st[1]),
+           stat_mean(&st[2]), stat_se(&st[0]));
+}
+
 /* Another seed gives other noise with the same mean: pixel by pixel the
  * differences of two renders average to 0. */
 static void test_seed(void)
@@ -582,6 +612,7 @@ int main(void)
     test_sphere_is_point();
     sky_checks();
     test_estimators_agree();
+    test_glowing_cone();
     test_seed();
     return failures != 0;
 }
