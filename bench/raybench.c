@@ -789,6 +789,56 @@ static void rb_free_all(RbAll *A)
     kd_free(A->kd), bvh_free(A->sah), bvh_free(A->median), grid_free(A->g);
 }
 
+/* The same for the BVH (both builds) and the grid: CPU seconds of each build,
+ * best of several, and the exponent of each against N. */
+static void rb_build_others(long maxn)
+{
+    static const long sizes[] = { 10000, 30000, 100000, 300000, 1000000, 3000000 };
+    static const int which[3] = { RB_BVH, RB_BVH_MEDIAN, RB_GRID };
+    double sx = 0, sxx = 0, sy[3] = {0}, sxy[3] = {0};
+    int i, j, count = 0;
+    printf("Build time against N, the other structures (the same cube-spheres; CPU seconds, best of 5, of 2 "
+           "past a second)\n%10s", "triangles");
+    for (j = 0; j < 3; j++) printf(" %11s s %7s", rb_names[which[j]], "ns/tri");
+    printf("\n");
+    for (i = 0; i < (int)(sizeof sizes / sizeof sizes[0]) && sizes[i] <= maxn; i++) {
+        int k = (int)floor(sqrt(sizes[i] / 12.0) + 0.5), n, r;
+        Scene s;
+        RbAll A;
+        default_scene(&s);
+        rb_cube_sphere(&s, k);
+        build_accel(&s, "none");
+        memset(&A, 0, sizeof A);
+        A.s = &s;
+        n = nobj(&s);
+        printf("%10d", n);
+        for (j = 0; j < 3; j++) {
+            double best = HUGE_VAL;
+            for (r = 0; r < 5 && (r < 2 || best < 1); r++) {
+                double c = rb_cpu_build(&A, which[j]);
+                if (c < best) best = c;
+            }
+            printf(" %13.4f %7.0f", best, best / n * 1e9);
+            sy[j] += log(best), sxy[j] += log((double)n) * log(best);
+            A.build[which[j]] = best;
+        }
+        printf("\n");
+        for (j = 0; j < 3; j++)
+            printf("result structure=%s triangles=%d build_s=%.5f\n", rb_names[which[j]], n,
+                   A.build[which[j]]);
+        sx += log((double)n), sxx += log((double)n) * log((double)n);
+        count++;
+        bvh_free(A.sah), bvh_free(A.median), grid_free(A.g);
+        rb_free_scene(&s);
+    }
+    if (count < 2) return;
+    printf("build time ~ N^p:");
+    for (j = 0; j < 3; j++) {
+        double p = (count * sxy[j] - sx * sy[j]) / (count * sxx - sx * sx);
+        printf(" %s %.3f%s", rb_names[which[j]], p, j < 2 ? "," : "\n");
+    }
+}
+
 /* ------------------------------------------------------------------ main */
 
 static long rb_count(const char *arg, long max)
@@ -993,6 +1043,7 @@ int main(int argc, char **argv)
     if (argc < 2) rb_usage();
     if (!strcmp(argv[1], "build") && argc <= 3) {
         rb_build_table(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
+        rb_build_others(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
         return 0;
     }
     if (!strcmp(argv[1], "anim") && argc == 5) {

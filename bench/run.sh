@@ -12,7 +12,8 @@
 #   spd     ./ray --accel kd against --accel none on the SPD scenes, one
 #           thread, same small image for both: time per ray and its ratio
 #   build   kd-tree build time against N (10k to 1M triangles), the fitted
-#           exponent, and the tree's bytes per triangle (bench/raybench.c)
+#           exponent, and the tree's bytes per triangle; the same for the
+#           BVH (SAH and median) and the grid (bench/raybench.c)
 #   rays    traversal Mrays/s on meshes, one thread, primary and random rays,
 #           against Embree's rtcIntersect1 on the very same rays, hits
 #           compared ray by ray (bench/raybench.c, ../shared/embree)
