@@ -2,17 +2,18 @@
  * knows only through the callbacks of prims.h.  bvh.h maps the lecture's
  * slide, BVH_Intersect(ray, node), to the functions below.
  *
- * Traversal: depth first, the nearer child first, the farther one on a
- * stack, dropped when the ray enters its box beyond the nearest hit found
- * meanwhile.  Each primitive sits in exactly one leaf, so unlike the
+ * Traversal: depth first over four-way nodes (collapsed from the binary
+ * tree the build makes), the nearest child first, the farther ones on a
+ * stack, each dropped when the ray enters its box beyond the nearest hit
+ * found meanwhile.  Each primitive sits in exactly one leaf, so unlike the
  * kd-tree no mailbox is needed.
  *
  * Build, two ways (bvh_build's method):
  *   BVH_SAH     the surface area heuristic over binned centroids (Wald 2007,
  *               "On fast construction of SAH-based bounding volume
  *               hierarchies"): each node's primitives are counted into BINS
- *               slabs of their centroids along each axis, and the K - 1
- *               planes between slabs are priced by one sweep from each end.
+ *               slabs of their centroids along each axis, and the planes
+ *               between slabs are priced by one sweep from each end.
  *               O(N) per level, O(N log N) in all.
  *   BVH_MEDIAN  half the primitives on each side, by their centroids along
  *               the longest axis (the lecture's "mediana"); leaves of at most

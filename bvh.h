@@ -6,9 +6,9 @@
  *   BVH_Intersect(ray, node)                          bvh_intersect
  *     if node is a leaf                               (count > 0)
  *       Intersect(ray, node.object)                   test_leaf: the hit callback
- *     else if Intersect_P(ray, node.BoundingBox)      box_entry
- *       for each child of node do                     nearer child first
- *         BVH_Intersect(ray, child)
+ *     else if Intersect_P(ray, node.BoundingBox)      children: the slab test of
+ *       for each child of node do                       a node's four boxes at once,
+ *         BVH_Intersect(ray, child)                     nearest child first
  *
  * Each primitive is in the tree exactly once: a BVH splits the objects, not
  * space, so children's boxes may overlap.  That is why, as the slide warns,
@@ -18,10 +18,10 @@
  *
  * bvh_intersect is the slide, recursive, behind bvh_intersect_recursive: the
  * readable reference.  bvh_nearest and bvh_any are the fast path: the same
- * nodes in the same order, the recursion turned into a loop with the far
- * child on a stack.  bvh_refit recomputes the boxes after primitives move,
- * without rebuilding: the lecture's question "which structures suit
- * animation?".
+ * nodes in the same order, the recursion turned into a loop with the
+ * farther children on a stack.  bvh_refit recomputes the boxes after
+ * primitives move, without rebuilding: the lecture's question "which
+ * structures suit animation?".
  *
  * Usage:
  *     prims p = { my_bounds, NULL, my_hit, my_scene };   (clip is not used)

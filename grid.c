@@ -64,6 +64,7 @@ struct grid {
     int res[3];
     double hi[3];                  /* the scene box's far corner */
     double scale;                  /* largest |coordinate| of the scene box */
+    double narrow;                 /* the narrowest cell side (of axes cut in two or more) */
     uint32_t *start;               /* cell c lists list[start[c] .. start[c+1]) */
     int *list;
     int *all;                      /* every primitive with a box, for the fallback */
@@ -246,7 +247,10 @@ static int query(const grid *g, const prims *p, const double org[3], const doubl
     }
     if (!(tmin <= *best_t)) return -1;
     if (!setup_ray(g, org, dir, skip, tmin, *best_t, &r)) return -1;
-    if (!(s <= FAST_MAX && dmax <= FAST_MAX && dmax >= FAST_MIN))   /* every primitive */
+    /* Every primitive, for rays out of range, and where the margin is wider
+     * than half a cell (a scene far from the origin, or a far ray origin):
+     * the walk would visit blocks of cells and gain nothing. */
+    if (!(s <= FAST_MAX && dmax <= FAST_MAX && dmax >= FAST_MIN) || 2 * r.delta > g->narrow)
         return test_list(g->all, g->nall, p, &r, ray, tmin, any, best_t, -1, c);
     return walk(g, p, &r, ray, tmin, any, best_t, c);
 }
@@ -431,6 +435,9 @@ grid *grid_build(int n, const prims *p)
     g->nall = scene_box(g, n, p, g->all);
     resolution(g, p);
     g->ncells = (long)g->res[0] * g->res[1] * g->res[2];
+    g->narrow = HUGE_VAL;
+    for (a = 0; a < 3; a++)
+        if (g->res[a] > 1 && g->w[a] < g->narrow) g->narrow = g->w[a];
     for (k = 0; k < g->nall && !L.failed; k++) {
         double lo[3], hi[3];
         p->bounds(p->user, g->all[k], lo, hi);

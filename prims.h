@@ -1,7 +1,7 @@
 /* prims.h - how an acceleration structure sees a scene: one table of
  * callbacks.
  *
- * The structures (kdtree.c today; a BVH and a grid beside it) never see a
+ * The structures (kdtree.c, bvh.c and grid.c) never see a
  * sphere or a triangle.  The renderer describes its primitives, numbered
  * 0..n-1, by three callbacks and a pointer handed back to them:
  *

@@ -789,6 +789,56 @@ static void rb_free_all(RbAll *A)
     kd_free(A->kd), bvh_free(A->sah), bvh_free(A->median), grid_free(A->g);
 }
 
+/* The same for the BVH (both builds) and the grid: CPU seconds of each build,
+ * best of several, and the exponent of each against N. */
+static void rb_build_others(long maxn)
+{
+    static const long sizes[] = { 10000, 30000, 100000, 300000, 1000000, 3000000 };
+    static const int which[3] = { RB_BVH, RB_BVH_MEDIAN, RB_GRID };
+    double sx = 0, sxx = 0, sy[3] = {0}, sxy[3] = {0};
+    int i, j, count = 0;
+    printf("Build time against N, the other structures (the same cube-spheres; CPU seconds, best of 5, of 2 "
+           "past a second)\n%10s", "triangles");
+    for (j = 0; j < 3; j++) printf(" %11s s %7s", rb_names[which[j]], "ns/tri");
+    printf("\n");
+    for (i = 0; i < (int)(sizeof sizes / sizeof sizes[0]) && sizes[i] <= maxn; i++) {
+        int k = (int)floor(sqrt(sizes[i] / 12.0) + 0.5), n, r;
+        Scene s;
+        RbAll A;
+        default_scene(&s);
+        rb_cube_sphere(&s, k);
+        build_accel(&s, "none");
+        memset(&A, 0, sizeof A);
+        A.s = &s;
+        n = nobj(&s);
+        printf("%10d", n);
+        for (j = 0; j < 3; j++) {
+            double best = HUGE_VAL;
+            for (r = 0; r < 5 && (r < 2 || best < 1); r++) {
+                double c = rb_cpu_build(&A, which[j]);
+                if (c < best) best = c;
+            }
+            printf(" %13.4f %7.0f", best, best / n * 1e9);
+            sy[j] += log(best), sxy[j] += log((double)n) * log(best);
+            A.build[which[j]] = best;
+        }
+        printf("\n");
+        for (j = 0; j < 3; j++)
+            printf("result structure=%s triangles=%d build_s=%.5f\n", rb_names[which[j]], n,
+                   A.build[which[j]]);
+        sx += log((double)n), sxx += log((double)n) * log((double)n);
+        count++;
+        bvh_free(A.sah), bvh_free(A.median), grid_free(A.g);
+        rb_free_scene(&s);
+    }
+    if (count < 2) return;
+    printf("build time ~ N^p:");
+    for (j = 0; j < 3; j++) {
+        double p = (count * sxy[j] - sx * sy[j]) / (count * sxx - sx * sx);
+        printf(" %s %.3f%s", rb_names[which[j]], p, j < 2 ? "," : "\n");
+    }
+}
+
 /* ------------------------------------------------------------------ main */
 
 static long rb_count(const char *arg, long max)
@@ -797,6 +847,156 @@ static long rb_count(const char *arg, long max)
     long v = strtol(arg, &end, 10);
     if (end == arg || *end || v < 1 || v > max) rb_die("expected a whole number, not", arg);
     return v;
+}
+
+/* ------------------------------------------------------------ animation */
+
+/* The lecture's question "which structures suit animation?", measured.
+ * `raybench anim SCENE.nff FRAMES MOVERS` drops MOVERS balls through the
+ * scene (along its NFF up vector, from above its box to below it, over the
+ * frames); MOVERS 0 instead moves every sphere of the scene, each turned
+ * about the up axis through the box's centre by an angle that grows with
+ * its height (a twist: neighbours drift apart).  Each frame, four
+ * strategies get the structure up to date and trace 256x256 primary rays
+ * from the scene's camera: rebuild the kd-tree, rebuild the BVH, refit the
+ * BVH built at frame 0, rebuild the grid.  Per strategy: CPU seconds to
+ * build (or refit) and to trace, summed over the frames, and the refitted
+ * BVH's trace time against the rebuilt one's as the frames go by. */
+typedef struct {
+    vec *from;        /* each moving sphere's place at frame 0 */
+    int first, count; /* the moving spheres */
+    vec up, centre;
+    double height;    /* the box's extent along up */
+    int twist;
+} RbMotion;
+
+static void rb_move(Scene *s, const RbMotion *m, double f)
+{
+    int k;
+    for (k = 0; k < m->count; k++) {
+        vec p = m->from[k];
+        if (m->twist) {   /* turned about up through the centre */
+            vec c = sub(p, m->centre), axial = scale(dot(c, m->up), m->up), r = sub(c, axial);
+            vec q = cross(m->up, r);
+            double h = dot(c, m->up) / (m->height > 0 ? m->height : 1), a = 3 * f * h;
+            p = add(m->centre, add(axial, add(scale((real)cos(a), r), scale((real)sin(a), q))));
+        } else
+            p = sub(p, scale((real)(f * 2 * m->height), m->up));   /* falls two box heights */
+        s->sph[m->first + k].cen = p;
+    }
+}
+
+static double rb_trace_cpu(const Scene *s, const RbRay *rays, long n)
+{
+    double c0 = rb_cpu();
+    long i;
+    for (i = 0; i < n; i++) {
+        double o[3], d[3], tmax = INFINITY;
+        Query q = rb_query(&rays[i], o, d);
+        if (s->accel == ACCEL_KD) kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
+        else if (s->accel == ACCEL_BVH) bvh_nearest(s->bvh, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
+        else grid_nearest(s->grid, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
+    }
+    return rb_cpu() - c0;
+}
+
+/* One strategy's frame: the structure brought up to date (refit or a new
+ * build), its CPU seconds in *build; returns the trace's. */
+static double rb_frame(Scene *s, int strategy, const RbRay *rays, long n, double *build)
+{
+    double c0 = rb_cpu();
+    if (strategy == 2 && s->bvh) bvh_refit(s->bvh, &s->prims);
+    else {
+        if (s->kd) kd_free(s->kd), s->kd = NULL;
+        if (s->bvh) bvh_free(s->bvh), s->bvh = NULL;
+        if (s->grid) grid_free(s->grid), s->grid = NULL;
+        if (!build_accel(s, strategy == 0 ? "kd" : strategy == 3 ? "grid" : "bvh")) exit(1);
+    }
+    *build = rb_cpu() - c0;
+    return rb_trace_cpu(s, rays, n);
+}
+
+static void rb_anim(const char *path, int frames, int movers)
+{
+    static const char *const names[4] = { "rebuild kd", "rebuild BVH", "refit BVH", "rebuild grid" };
+    Scene s[4];
+    RbMotion m;
+    RbRay *rays;
+    double eye[3], at[3], up[3], fov, build[4] = {0}, trace[4] = {0}, lo[3], hi[3];
+    double first_ratio = 0, last_ratio = 0, mid_ratio = 0;
+    int k, f, a, w = 256;
+    if (!rb_nff_view(path, eye, at, up, &fov)) rb_die("no view in", path);
+    for (k = 0; k < 4; k++) {
+        default_scene(&s[k]);
+        if (!load_scene(&s[k], path)) exit(1);
+    }
+    memset(&m, 0, sizeof m);
+    m.up = unit(v3(up[0], up[1], up[2]));
+    build_accel(&s[0], "none");   /* the callbacks, for the box */
+    for (a = 0; a < 3; a++) lo[a] = HUGE_VAL, hi[a] = -HUGE_VAL;
+    for (k = 0; k < nobj(&s[0]); k++) {
+        double l[3], h[3];
+        prim_bounds(&s[0], k, l, h);
+        for (a = 0; a < 3; a++) lo[a] = fmin(lo[a], l[a]), hi[a] = fmax(hi[a], h[a]);
+    }
+    m.centre = v3((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+    m.height = fabs((hi[0] - lo[0]) * m.up.x) + fabs((hi[1] - lo[1]) * m.up.y) + fabs((hi[2] - lo[2]) * m.up.z);
+    m.twist = movers == 0;
+    rb_state = 7;
+    for (k = 0; k < 4; k++) {   /* the same balls in each copy */
+        uint64_t seed = rb_state;
+        int j;
+        if (m.twist) break;
+        for (j = 0; j < movers; j++) {
+            vec p = v3(lo[0] + (hi[0] - lo[0]) * rb_uniform(), lo[1] + (hi[1] - lo[1]) * rb_uniform(),
+                       lo[2] + (hi[2] - lo[2]) * rb_uniform());
+            p = add(p, scale((real)(m.height * (1 + rb_uniform())), m.up));   /* above the box */
+            add_sphere(&s[k], p, (real)(0.01 * m.height), rb_white(&s[k]));
+        }
+        if (k < 3) rb_state = seed;
+    }
+    m.first = m.twist ? 0 : s[0].nsph - movers;
+    m.count = m.twist ? s[0].nsph : movers;
+    m.from = malloc(((size_t)m.count + 1) * sizeof *m.from);
+    if (!m.from) rb_die("out of memory", NULL);
+    for (k = 0; k < m.count; k++) m.from[k] = s[0].sph[m.first + k].cen;
+    for (k = 0; k < 4; k++) build_accel(&s[k], "none");
+    rays = rb_primary(&s[0], w, w, path);
+    printf("animation %s: %d objects, %s, %d frames, %dx%d primary rays a frame, one thread, CPU time\n",
+           path, nobj(&s[0]), m.twist ? "every sphere twisted about the up axis" : "balls falling through",
+           frames, w, w);
+    printf("%6s", "frame");
+    for (k = 0; k < 4; k++) printf("  %-12s build/trace ms", names[k]);
+    printf("\n");
+    for (f = 0; f < frames; f++) {
+        double b[4], t[4];
+        for (k = 0; k < 4; k++) {
+            rb_move(&s[k], &m, (double)f / (frames > 1 ? frames - 1 : 1));
+            t[k] = rb_frame(&s[k], k, rays, (long)w * w, &b[k]);
+            build[k] += b[k], trace[k] += t[k];
+        }
+        if (f == 0) first_ratio = t[2] / t[1];
+        if (f == frames / 2) mid_ratio = t[2] / t[1];
+        last_ratio = t[2] / t[1];
+        if (f % 10 == 0 || f == frames - 1) {
+            printf("%6d", f);
+            for (k = 0; k < 4; k++) printf("  %8.2f / %7.2f            ", b[k] * 1e3, t[k] * 1e3);
+            printf("\n");
+        }
+    }
+    printf("per frame, mean:");
+    for (k = 0; k < 4; k++)
+        printf("  %s %.2f + %.2f = %.2f ms", names[k], build[k] / frames * 1e3, trace[k] / frames * 1e3,
+               (build[k] + trace[k]) / frames * 1e3);
+    printf("\nrefitted BVH's trace time over a rebuilt one's: frame 0 %.2f, frame %d %.2f, frame %d %.2f\n",
+           first_ratio, frames / 2, mid_ratio, frames - 1, last_ratio);
+    for (k = 0; k < 4; k++)
+        printf("result anim=%s strategy=%d build_ms=%.3f trace_ms=%.3f\n", m.twist ? "twist" : "fall", k,
+               build[k] / frames * 1e3, trace[k] / frames * 1e3);
+    printf("result anim=%s refit_ratio_first=%.3f refit_ratio_mid=%.3f refit_ratio_last=%.3f\n",
+           m.twist ? "twist" : "fall", first_ratio, mid_ratio, last_ratio);
+    free(rays), free(m.from);
+    for (k = 0; k < 4; k++) rb_free_scene(&s[k]);
 }
 
 /* The rays made here for `made` and `accel`: W x H primary rays (arg[0],
@@ -832,7 +1032,8 @@ static void rb_usage(void)
           "       raybench made MESH.obj W H N [VIEW.nff] (W x H primary and N random rays)\n"
           "       raybench accel SCENE W H N [VIEW.nff]   (every structure on W x H primary and N\n"
           "                                                random rays; SCENE .obj or .nff)\n"
-          "       raybench accel SCENE RAYS.bin...        (every structure on RAYHITS1 rays)\n", stderr);
+          "       raybench accel SCENE RAYS.bin...        (every structure on RAYHITS1 rays)\n"
+          "       raybench anim SCENE.nff FRAMES MOVERS   (rebuild or refit as objects move)\n", stderr);
     exit(2);
 }
 
@@ -842,6 +1043,11 @@ int main(int argc, char **argv)
     if (argc < 2) rb_usage();
     if (!strcmp(argv[1], "build") && argc <= 3) {
         rb_build_table(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
+        rb_build_others(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
+        return 0;
+    }
+    if (!strcmp(argv[1], "anim") && argc == 5) {
+        rb_anim(argv[2], (int)rb_count(argv[3], 100000), (int)strtol(argv[4], NULL, 10));
         return 0;
     }
     if (!strcmp(argv[1], "accel") && argc >= 4) {

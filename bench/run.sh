@@ -12,7 +12,8 @@
 #   spd     ./ray --accel kd against --accel none on the SPD scenes, one
 #           thread, same small image for both: time per ray and its ratio
 #   build   kd-tree build time against N (10k to 1M triangles), the fitted
-#           exponent, and the tree's bytes per triangle (bench/raybench.c)
+#           exponent, and the tree's bytes per triangle; the same for the
+#           BVH (SAH and median) and the grid (bench/raybench.c)
 #   rays    traversal Mrays/s on meshes, one thread, primary and random rays,
 #           against Embree's rtcIntersect1 on the very same rays, hits
 #           compared ray by ray (bench/raybench.c, ../shared/embree)
@@ -23,6 +24,11 @@
 #           and none, and the recursive forms kd-rec and bvh-rec; Embree on
 #           the sphere's very rays, alternating with ours (bench/raybench.c
 #           accel)
+#   anim    which structures suit animation: 300 balls falling through SPD
+#           gears, and every sphere of SPD balls twisted, 60 frames, one
+#           thread; per frame the build (or refit) and the trace of 256x256
+#           primary rays, for rebuilding the kd-tree, rebuilding the BVH,
+#           refitting the BVH, rebuilding the grid (bench/raybench.c anim)
 #   pov     SPD balls at 512x512, one thread: ./ray against --accel none and
 #           against POV-Ray 3.7; and POV-Ray's other SPD scenes
 #   pt      the path tracer: each estimator's CPU time against its RMSE on the
@@ -39,7 +45,7 @@
 #   *.log       the raw output each table was read from
 #
 # Knobs (environment; defaults keep `make bench` near 4 minutes on 2 cores):
-#   BENCH_PARTS="render spd build rays accel pov pt"
+#   BENCH_PARTS="render spd build rays accel anim pov pt"
 #   BENCH_SPP="1 4 16"       sample counts to time
 #   BENCH_REF_SPP=64         reference sample count (should exceed the above)
 #   BENCH_FLAKE_LEVEL=4      sphereflake recursion (4: 7381 spheres)
@@ -88,7 +94,7 @@ FLAKE_SIZE=${BENCH_FLAKE_SIZE:-}
 FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
-PARTS=${BENCH_PARTS:-render spd build rays accel pov pt}
+PARTS=${BENCH_PARTS:-render spd build rays accel anim pov pt}
 SPD_DIR=${BENCH_SPD_DIR:-scenes/spd}
 POV_DIR=${BENCH_POV_DIR:-../shared/spd/pov}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
@@ -113,7 +119,7 @@ for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N; do
   case $n in ''|*[!0-9]*|0) die "BENCH_NONE_BUDGET, BENCH_BUILD_MAX, BENCH_RAYS_RES and BENCH_RAYS_N must be whole numbers from 1, not '$n'";; esac
 done
 for p in $PARTS; do
-  case $p in render|spd|build|rays|accel|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel pov pt)";; esac
+  case $p in render|spd|build|rays|accel|anim|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim pov pt)";; esac
 done
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT" || die "cannot create $OUT"
@@ -777,6 +783,34 @@ if part accel; then
     echo "(st/te: steps (nodes, cells) and hit tests per ray.  $((SECONDS - t_part)) s)"
     echo
   } | tee -a "$OUT/bench.txt"
+fi
+
+# ------------------------------------------------------------- animation
+if part anim; then
+  t_part=$SECONDS
+  echo "Which structures suit animation? (bench/raybench.c anim; CPU milliseconds per frame, one thread)" | tee -a "$OUT/bench.txt"
+  if [ -z "$RAYBENCH" ]; then
+    echo "bench/raybench.c did not build: skipped" | tee -a "$OUT/bench.txt"
+  else
+    for job in "gears_s4 60 300" "balls_s4 60 0"; do
+      set -- $job
+      scene=$SPD_DIR/$1.nff
+      [ -f "$scene" ] || scene=scenes/spd/$1.nff
+      if [ ! -f "$scene" ]; then
+        echo "$1 not found: skipped" | tee -a "$OUT/bench.txt"
+        continue
+      fi
+      say "anim: $1"
+      if "$RAYBENCH" anim "$scene" "$2" "$3" >"$OUT/anim-$1.log" 2>&1; then
+        grep -v '^result ' "$OUT/anim-$1.log" | tee -a "$OUT/bench.txt"
+      else
+        echo "$1: raybench anim failed, see $OUT/anim-$1.log" | tee -a "$OUT/bench.txt"
+        status=1
+      fi
+    done
+  fi
+  echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
+  echo | tee -a "$OUT/bench.txt"
 fi
 
 # ---------------------------------------------- balls and POV-Ray, 512x512

@@ -1024,6 +1024,43 @@ static void check_rays(const accel *A, const scene *s, const prims *p, const voi
     free(sp.axis), free(sp.pos);
 }
 
+/* Rays the fast walks do not take: origins 10^12 scene sizes away, aimed at
+ * the scene (the margin outgrows every cell), and directions scaled by
+ * 2^-70 or 2^70 (out of the float test's range).  The structures answer
+ * them by testing every primitive, or walk them as usual; either way the
+ * answer must be brute force's. */
+static void check_far(const accel *A, const scene *s, const prims *p, const void *t,
+                      long nrays)
+{
+    box3 b;
+    long k, bad = 0;
+    char msg[200], what[64];
+    scene_box(s, &b);
+    for (k = 0; k < nrays; k++) {
+        ray r;
+        double target[3], f = k % 3 == 0 ? 0x1p-70 : k % 3 == 1 ? 0x1p70 : 1, tw, tg;
+        int a, want, got;
+        point_in(s, &b, 0, 0, target);
+        random_dir(r.d);
+        for (a = 0; a < 3; a++) {
+            double size = b.hi[a] - b.lo[a] + 1;
+            r.o[a] = k % 3 == 2 ? target[a] - 1e12 * size * r.d[a] : target[a] - 3 * size * r.d[a];
+            r.d[a] *= f;
+        }
+        tw = tg = HUGE_VAL;
+        want = brute_nearest(s, &r, -1, 0, &tw);
+        got = nearest(A, t, p, &r, -1, 0, &tg, NULL);
+        if (want != got || memcmp(&tw, &tg, sizeof tw)) {
+            bad++;
+            show_mismatch("far", GENERAL, &r, 0, HUGE_VAL, "brute", want, tw, A->name, got, tg);
+        }
+    }
+    sprintf(msg, "%ld rays from 10^12 sizes away or with directions of 2^-70 and 2^70, "
+            "%ld mismatches", nrays, bad);
+    sprintf(what, "%s far", A->name);
+    report(bad == 0, msg, s->name, what);
+}
+
 /* ---- refit ------------------------------------------------------------------ */
 
 /* A quarter of the primitives move by a step of up to 2 along each axis, on
@@ -1121,6 +1158,7 @@ int main(int argc, char **argv)
     check_shape(A, &s, t);
     check_determinism(A, &s, &p, t);
     check_rays(A, &s, &p, t, nrays, "");
+    if (strcmp(s.name, "same")) check_far(A, &s, &p, t, nrays / 100 + 1);
     if (A->kind == BVH_SAH_BUILD || A->kind == BVH_MEDIAN_BUILD) check_refit(A, &s, &p, t, nrays);
     release(A, t);
     free(s.p);
