@@ -1,6 +1,7 @@
 /* ray.c - the lecture "Ray Tracing + Global Illumination" as one C file:
  * Whitted's recursive ray tracer and Kajiya's path tracer side by side,
- * spheres, cones and triangles, and the kd-tree (kdtree.c) that finds hits.
+ * spheres, cones and triangles, and the structures that find hits (kdtree.c,
+ * bvh.c, grid.c).
  *
  *     make && ./ray -s 640x480 -n 4 scenes/whitted.sph      (writes whitted.ppm)
  *     ./ray scenes/cornell.sph                              (path traced)
@@ -18,8 +19,10 @@
  *     --no-roulette, --seed N     for the path tracer
  *     --gamma     the sRGB curve on Whitted's output (path tracing always has it)
  *     --p3        plain-text PPM (P3) instead of binary (P6)
- *     --accel A   kd (the kd-tree of kdtree.c), none (test every object), or
- *                 auto (default: the tree once there are 8 objects or more)
+ *     --accel A   kd (kdtree.c), bvh (bvh.c), grid (grid.c), none (test every
+ *                 object), or auto (default: the scene's `accel`, else from 8
+ *                 objects on the structure a short probe render finds fastest)
+ *     --view V    steps, normal or depth: what a pixel's ray meets, as a picture
  *     --stats     print rays by kind, hits, the tree and time on stderr
  *     --help
  * SCENE is the sphere format (README.md), or an NFF file (Eric Haines'
@@ -70,7 +73,7 @@
  *       trace()           RayTrace(R)                               RayTrace(R)
  *       nearest_hit()     the nearest hit                           finding hits
  *       query()           the record the tree hands back
- *       find_nearest()    asks the kd-tree (kd_nearest in kdtree.c), or every object
+ *       find_nearest()    asks the structure (kd_nearest, bvh_nearest or grid_nearest), or every object
  *       prim_hit()        the tree's call for one object of a leaf
  *       kind()            sphere, cone or triangle
  *       hit_object()      its intersection test
@@ -196,6 +199,8 @@ typedef struct {
     vec ambient, background;
     int cull;                 /* for triangles still to come: `sided 1` */
     int integrator;           /* WHITTED or PATH */
+    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, or 0 */
+    real far;                 /* --view depth: the farthest point of the scene from the eye */
     int spp;                  /* samples per pixel the scene asks for (0: none said) */
     int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
     int roulette;             /* 1: Russian roulette ends paths */
@@ -225,6 +230,7 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
  * tracer's three estimators of the light at a point: by sampling the BSDF
  * only, by next-event estimation, or by both weighed by MIS. */
 enum { WHITTED, PATH };
+enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH };
 enum { BSDF_ONLY, NEE, MIS };
 
 /* Objects are numbered spheres first, then cones, then triangles. */
@@ -343,6 +349,7 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
 static void put_pixel(Image *img, int i, int j, vec c);
 static unsigned char to_byte(real v);
 static real srgb(real v);
+static vec pixel_view(const Scene *s, int i, int j, Worker *wk);   /* --view, in the plumbing */
 
 /* RayTrace(R): Whitted's recursive ray tracing */
 static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
@@ -426,8 +433,9 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 {
     int i;
     for (i = 0; i < s->w; i++)
-        put_pixel(img, i, j, s->integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
-                                                   : pixel_color(s, i, j, spp, wk));
+        put_pixel(img, i, j, s->view ? pixel_view(s, i, j, wk)      /* --view: see the plumbing */
+                             : s->integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
+                             : pixel_color(s, i, j, spp, wk));
 }
 
 
@@ -1851,6 +1859,61 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         add_counts(total, &wk.count);
     }
     if (o->progress) fprintf(stderr, "\r%30s\r", "");
+}
+
+/* ------------------------------------------------------------------ --view */
+
+/* The heat scale of --view steps: piecewise linear through black (0), blue
+ * (25), red (50), yellow (100) and white (200 and more). */
+static vec heat(real w)
+{
+    static const double at[5] = { 0, 25, 50, 100, 200 };
+    static const double rgb[5][3] = { { 0, 0, 0 }, { 0, 0, 1 }, { 1, 0, 0 }, { 1, 1, 0 }, { 1, 1, 1 } };
+    int k = 0;
+    double f;
+    if (!(w < at[4])) return v3(1, 1, 1);
+    while (w > at[k + 1]) k++;
+    f = (w - at[k]) / (at[k + 1] - at[k]);
+    return v3((real)(rgb[k][0] + f * (rgb[k + 1][0] - rgb[k][0])),
+              (real)(rgb[k][1] + f * (rgb[k + 1][1] - rgb[k][1])),
+              (real)(rgb[k][2] + f * (rgb[k + 1][2] - rgb[k][2])));
+}
+
+/* For --view depth: the distance from the eye to the farthest corner of
+ * the box of every object (1 when there is none). */
+static real farthest(const Scene *s)
+{
+    double lo[3], hi[3], best = 0;
+    int i, c;
+    for (i = 0; i < nobj(s); i++) {
+        prim_bounds((void *)s, i, lo, hi);
+        for (c = 0; c < 8; c++) {
+            vec corner = v3((real)(c & 1 ? hi[0] : lo[0]), (real)(c & 2 ? hi[1] : lo[1]),
+                            (real)(c & 4 ? hi[2] : lo[2]));
+            vec d = sub(corner, s->cam.eye);
+            best = fmax(best, sqrt(dot(d, d)));
+        }
+    }
+    return (real)(best > 0 ? best : 1);
+}
+
+/* --view: what one ray through the pixel's centre meets, as a picture.
+ * steps: the acceleration structure's work for it, nodes or cells visited
+ * plus intersection tests, on one fixed scale so that two structures'
+ * pictures compare: black 0, blue 25, red 50, yellow 100, white 200 or
+ * more.  normal: the shading normal at the hit, x, y, z from -1..1 to 0..1
+ * as red, green, blue.  depth: the hit's distance as grey, white at the eye
+ * to black at the scene's farthest point.  Nothing hit: black. */
+static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
+{
+    Counts before = wk->count;
+    Hit h;
+    int hit = nearest_hit(s, camera_ray(&s->cam, s->w, s->h, i + (real)0.5, j + (real)0.5), &h, wk);
+    if (s->view == VIEW_STEPS)
+        return heat((real)(wk->count.steps - before.steps + wk->count.tests - before.tests));
+    if (!hit) return v3(0, 0, 0);
+    if (s->view == VIEW_NORMAL) return scale((real)0.5, add(h.n, v3(1, 1, 1)));
+    return v3(1 - h.t / s->far, 1 - h.t / s->far, 1 - h.t / s->far);
 }
 
 /* ------------------------------------------------------------- scene input */
@@ -3323,6 +3386,9 @@ static void usage(FILE *to)
           "             (uniform grid), none (test every object) or auto (default:\n"
           "             the scene's `accel` line, else from 8 objects up the one that\n"
           "             renders a 32x32 probe of the image fastest, its build included)\n"
+          "  --view V   instead of the picture, what a ray through each pixel's centre\n"
+          "             meets: steps (the structure's work: nodes or cells plus tests,\n"
+          "             black 0, blue 25, red 50, yellow 100, white 200), normal, depth\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr\n"
           "  --help     this text\n", to);
 }
@@ -3367,6 +3433,18 @@ static const char *accel_arg(const char *v)
         exit(2);
     }
     return accel_name(v);
+}
+
+/* --view's picture, or a usage error (exit 2) with the choices. */
+static int view_arg(const char *v)
+{
+    if (!strcmp(v, "steps")) return VIEW_STEPS;
+    if (!strcmp(v, "normal")) return VIEW_NORMAL;
+    if (strcmp(v, "depth")) {
+        fprintf(stderr, "ray: --view takes steps, normal or depth, not %s\n", v);
+        exit(2);
+    }
+    return VIEW_DEPTH;
 }
 
 /* The path tracer's estimator named by --estimator, or exit with the choices. */
@@ -3684,7 +3762,7 @@ int main(int argc, char **argv)
     const char *scene = NULL, *size = NULL, *accel = NULL, *name = NULL;
     char *auto_name = NULL;
     int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, w = 0, h = 0, integrator = -1;
-    int estimator = -1, roulette = 1;
+    int estimator = -1, roulette = 1, view = 0;
     long seed = -1;
     double t0, load, build;
     clock_t c0;
@@ -3702,6 +3780,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--p3")) plain = 1;
         else if (!strcmp(a, "--gamma")) gamma = 1;
         else if (!strcmp(a, "--stats")) stats = 1;
+        else if ((v = option_value(argc, argv, &i, "--view"))) view = view_arg(v);
         else if (!strcmp(a, "--pt")) integrator = PATH;
         else if (!strcmp(a, "--whitted")) integrator = WHITTED;
         else if (!strcmp(a, "--no-roulette")) roulette = 0;
@@ -3739,7 +3818,9 @@ int main(int argc, char **argv)
     build = now() - build;
     if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
 
-    if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, s.integrator == PATH || gamma)) {
+    s.view = view;
+    if (view == VIEW_DEPTH) s.far = farthest(&s);
+    if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, !view && (s.integrator == PATH || gamma))) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h);
         discard_output(&out);
         free_scene(&s); free(auto_name);

@@ -146,3 +146,25 @@ printf 'accel grid\n%s\n%s\n%s\n' "$good" "$good" "$good" > "$TMP/g.sph"
   || bad "scene line accel grid ignored"
 ./ray -s 8x8 --stats --accel bvh -o "$TMP/g.ppm" "$TMP/g.sph" 2>&1 | grep -q '^bvh ' && ok "--accel bvh overrides the scene's accel line" \
   || bad "--accel does not override the scene's accel line"
+
+# --view: the centre ray's work on the fixed scale (11 spheres through the
+# loop: 11 tests, heat 11 = 0.44 of blue = byte 112), the normal as colour
+# (a ball straight ahead: n = (0, -1, 0), colour (0.5, 0, 0.5) = 128 0 128),
+# and a usage error for another name.
+{ echo "camera 0 -5 0  0 0 0  0 0 1 30"
+  for k in 0 1 2 3 4 5 6 7 8 9; do echo "$((k * 3 - 13)) 20 0  1 1 1  .5  1 0 0 0 1"; done
+  echo "0 0 0  1 1 1  1  1 0 0 0 1"; } > "$TMP/view.sph"
+./ray -s 9x9 --view steps --accel none -o "$TMP/steps.ppm" "$TMP/view.sph" 2>/dev/null &&
+./ray -s 9x9 --view normal -o "$TMP/normal.ppm" "$TMP/view.sph" 2>/dev/null &&
+python3 -c "
+import sys
+def px(p, i, j):
+    d = open(p, 'rb').read(); h = d.split(b'\n', 3); w = int(h[1].split()[0]); k = 3 * (j * w + i)
+    return tuple(h[3][k:k + 3])
+assert px('$TMP/steps.ppm', 4, 4) == (0, 0, 112), px('$TMP/steps.ppm', 4, 4)
+assert px('$TMP/normal.ppm', 4, 4) == (128, 0, 128), px('$TMP/normal.ppm', 4, 4)
+" && ok "--view steps: 11 tests through the loop on the fixed scale; --view normal: the normal as colour" \
+  || bad "--view steps or normal"
+./ray --view heat -o "$TMP/h.ppm" "$TMP/view.sph" 2>"$TMP/err"; rc=$?
+[ $rc = 2 ] && grep -q "steps, normal or depth" "$TMP/err" && ok "--view heat: exit 2, the choices listed" \
+  || bad "--view heat: exit $rc"
