@@ -72,6 +72,39 @@
  * that fits in the 30-bit indices of a node. */
 #define STACK_SIZE 64
 
+/* The reference budget.  The SAH alone can make a tree of any size: near
+ * the centre of a fan of thin triangles every cell holds slivers, every
+ * plane cuts most of them, and yet the SAH finds each split worth it, level
+ * after level, so that cells and references grow as N^2 (a 50k-triangle
+ * fan took 238 s, 88.5M nodes and 3.8 GB).  Wald & Havran's O(N log N)
+ * assumes that a plane cuts few primitives (about sqrt(N)), and pbrt's
+ * depth limit (see build_node) bounds the depth, not the width.  So the
+ * build spends a budget, in the spirit of the fixed budgets of extra
+ * references that BVH builders give their spatial splits (Karras & Aila
+ * 2013): a leaf costs its references plus one (itself), and the tree may
+ * cost BUDGET * (N + 1) at most.  The root holds the whole budget.  A node
+ * splits only if what its children cost (their primitives as the SAH
+ * counted them, plus one each) can be paid from its budget and a common
+ * pool; the children share the node's budget in proportion to what they
+ * cost; a leaf puts what it did not spend into the pool, for later splits.
+ * A node's budget always covers its own cost, and the budgets of the nodes
+ * still to build, the pool and what the leaves cost always add up to
+ * BUDGET * (N + 1).  Hence
+ *     references + leaves <= BUDGET (N + 1),  nodes < 2 BUDGET (N + 1),
+ * and a list holds at most six events a reference: memory linear in N.  And
+ * time O(N log N): each level of the tree, at most 8 + 1.3 log2 N of them,
+ * handles at most BUDGET (N + 1) references in linear time, and the events
+ * sorted after the root's are those of cut primitives, two a reference that
+ * the cuts add (a plane through a convex primitive's box cuts the
+ * primitive, so the clip callback keeps it on both sides but for rounding).
+ * 16 leaves every tree of the SPD scenes, the 100k-triangle sphere, the 1M
+ * cube-sphere and test_kdtree's scenes as it was (8 changes the flat one,
+ * whose tree costs 9.6 a primitive); a 50k-triangle fan then builds in
+ * 0.5 s with 0.8M references (8: 0.23 s, 32: 1 s). */
+#ifndef BUDGET
+#define BUDGET 16
+#endif
+
 /* The traversal treats every cell as if it were grown by a margin
  * delta = RAY_EPS * (largest coordinate of the scene box and the ray origin)
  * on every side, and visits every cell whose grown box the ray passes
@@ -524,6 +557,7 @@ typedef struct {
     long top, stack_cap;  /* events in use on the stack, and room */
     int max_depth;
     double root_area;
+    double pool;          /* budget left unspent by finished subtrees */
     kd_info info;
     int failed;           /* out of memory, or more than 2^30 nodes */
 } kd_builder;
@@ -532,6 +566,7 @@ typedef struct {
     int found, axis, planar_left;
     float pos;
     double cost;
+    long nl, nr;  /* primitives on each side, by their boxes */
 } kd_split;
 
 /* Expected cost of cutting v at pos, with nl and nr primitives per side. */
@@ -546,11 +581,13 @@ static double sah(const kd_box *v, int axis, float pos, long nl, long nr,
     return nl == 0 || nr == 0 ? cost * EMPTY_BONUS : cost;
 }
 
-static void offer(kd_split *best, int axis, float pos, double cost, int planar_left)
+static void offer(kd_split *best, int axis, float pos, double cost, int planar_left,
+                  long nl, long nr)
 {
     if (cost < best->cost) {
         best->found = 1, best->axis = axis, best->pos = pos;
         best->cost = cost, best->planar_left = planar_left;
+        best->nl = nl, best->nr = nr;
     }
 }
 
@@ -561,7 +598,8 @@ static void consider(kd_split *best, const kd_box *v, int axis, float pos,
 {
     double left = sah(v, axis, pos, nl + np, nr, area);
     double right = sah(v, axis, pos, nl, np + nr, area);
-    offer(best, axis, pos, left <= right ? left : right, left <= right);
+    if (left <= right) offer(best, axis, pos, left, 1, nl + np, nr);
+    else offer(best, axis, pos, right, 0, nl, np + nr);
 }
 
 /* A plane on a face of the cell, with primitives lying in it: a floor at
@@ -575,9 +613,9 @@ static void consider_face(kd_split *best, const kd_box *v, int axis,
                           float pos, long nl, long np, long nr, double area)
 {
     if (pos == v->lo[axis])
-        offer(best, axis, pos, sah(v, axis, pos, nl + np, nr, area), 1);
+        offer(best, axis, pos, sah(v, axis, pos, nl + np, nr, area), 1, nl + np, nr);
     else
-        offer(best, axis, pos, sah(v, axis, pos, nl, np + nr, area), 0);
+        offer(best, axis, pos, sah(v, axis, pos, nl, np + nr, area), 0, nl, np + nr);
 }
 
 /* Other planes on or within a few float steps of a face of the cell are
@@ -621,7 +659,7 @@ static kd_split find_split(const kd_list *L, const kd_box *v)
     double area = box_area(v);
     int a;
     best.found = 0, best.axis = 0, best.planar_left = 1;
-    best.pos = 0, best.cost = HUGE_VAL;
+    best.pos = 0, best.cost = HUGE_VAL, best.nl = best.nr = 0;
     if (!(area > 0)) return best;  /* a line or a point: nothing to cut */
     for (a = 0; a < 3; a++) sweep(L, a, v, area, &best);
     return best;
@@ -942,31 +980,36 @@ static void note_node(kd_builder *b, const kd_box *v, int depth, long leaf_prims
 }
 
 /* Build the subtree of node `at` over the events L (which it frees) in cell
- * v.  A node becomes a leaf when
+ * v, with `budget` to spend (see BUDGET).  A node becomes a leaf when
  *   - it holds no primitive: nothing to gain;
  *   - it is at the depth limit, 8 + 1.3 log2 N: a guard against piles of
  *     overlapping primitives that no plane separates, where each split would
  *     copy them all to both sides (the rule of thumb of Pharr & Humphreys'
  *     pbrt); it also bounds the traversal's stack;
- *   - no candidate plane lies well inside the cell (see well_inside), or
+ *   - no candidate plane lies well inside the cell (see well_inside);
  *   - the best split costs at least as much as the leaf (COST_TEST * n): the
- *     automatic termination of the SAH (Wald & Havran 2006). */
+ *     automatic termination of the SAH (Wald & Havran 2006), or
+ *   - its budget and the pool cannot pay for the children. */
 static void build_node(kd_builder *b, long at, kd_list *L, const kd_box *v,
-                       int depth)
+                       int depth, double budget)
 {
     kd_split s;
     kd_list left, right;
     kd_box vl = *v, vr = *v;
     long child;
+    double need, share;
     attach(b, L);
-    s.found = 0;
+    s.found = 0, s.nl = s.nr = 0;
     if (L->count > 0 && depth < b->max_depth) s = find_split(L, v);
-    if (!s.found || s.cost >= COST_TEST * L->count) {
+    need = (double)s.nl + s.nr + 2;  /* what the children would cost */
+    if (!s.found || s.cost >= COST_TEST * L->count || need > budget + b->pool) {
         note_node(b, v, depth, L->count);
         make_leaf(b, at, L);
         drop(b, L);
+        b->pool += budget - (L->count + 1);
         return;
     }
+    if (need > budget) b->pool -= need - budget, budget = need;
     vl.hi[s.axis] = s.pos;
     vr.lo[s.axis] = s.pos;
     if (!split_lists(b, L, &s, &vl, &vr, &left, &right)) {
@@ -979,8 +1022,9 @@ static void build_node(kd_builder *b, long at, kd_list *L, const kd_box *v,
     note_node(b, v, depth, -1);
     b->nodes[at].u.split = s.pos;
     b->nodes[at].bits = (uint32_t)child << 2 | (uint32_t)s.axis;
-    build_node(b, child, &left, &vl, depth + 1);
-    build_node(b, child + 1, &right, &vr, depth + 1);
+    share = floor(budget * (left.count + 1) / (left.count + right.count + 2));
+    build_node(b, child, &left, &vl, depth + 1, share);
+    build_node(b, child + 1, &right, &vr, depth + 1, budget - share);
 }
 
 /* The events of all primitives, sorted once: the only full sort. */
@@ -1052,7 +1096,7 @@ kd_tree *kd_build(int n, const prims *p)
         b.root_area = box_area(&scene);
         b.nodes = malloc(16 * sizeof(kd_node));
         b.node_cap = 16, b.nnodes = 1;
-        if (b.nodes) build_node(&b, 0, &L, &scene, 0);
+        if (b.nodes) build_node(&b, 0, &L, &scene, 0, BUDGET * ((double)L.count + 1));
         else free_list(&L);
         free(b.stack), b.stack = NULL;
         if (b.nodes && !b.failed) t = finish(&b, &scene);
