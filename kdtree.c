@@ -836,14 +836,14 @@ static void drop(kd_builder *b, kd_list *L)
     }
 }
 
-/* Room on the stack for `need` events.  Half as much again is asked for, so
+/* Room on the stack for `need` events.  A quarter more is asked for, so
  * that it seldom moves; room not yet written to costs address space, not
  * memory, on systems that map pages as they are first written (Linux and
  * the BSDs do, for big blocks). */
 static int reserve(kd_builder *b, long need)
 {
     kd_event *grown;
-    long cap = need + need / 2 + 1024;
+    long cap = need + need / 4 + 1024;
     if (need <= b->stack_cap) return 1;
     grown = realloc(b->stack, cap * sizeof(kd_event));
     if (!grown) return 0;
