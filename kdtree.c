@@ -72,6 +72,39 @@
  * that fits in the 30-bit indices of a node. */
 #define STACK_SIZE 64
 
+/* The reference budget.  The SAH alone can make a tree of any size: near
+ * the centre of a fan of thin triangles every cell holds slivers, every
+ * plane cuts most of them, and yet the SAH finds each split worth it, level
+ * after level, so that cells and references grow as N^2 (a 50k-triangle
+ * fan took 238 s, 88.5M nodes and 3.8 GB).  Wald & Havran's O(N log N)
+ * assumes that a plane cuts few primitives (about sqrt(N)), and pbrt's
+ * depth limit (see build_node) bounds the depth, not the width.  So the
+ * build spends a budget, in the spirit of the fixed budgets of extra
+ * references that BVH builders give their spatial splits (Karras & Aila
+ * 2013): a leaf costs its references plus one (itself), and the tree may
+ * cost BUDGET * (N + 1) at most.  The root holds the whole budget.  A node
+ * splits only if what its children cost (their primitives as the SAH
+ * counted them, plus one each) can be paid from its budget and a common
+ * pool; the children share the node's budget in proportion to what they
+ * cost; a leaf puts what it did not spend into the pool, for later splits.
+ * A node's budget always covers its own cost, and the budgets of the nodes
+ * still to build, the pool and what the leaves cost always add up to
+ * BUDGET * (N + 1).  Hence
+ *     references + leaves <= BUDGET (N + 1),  nodes < 2 BUDGET (N + 1),
+ * and a list holds at most six events a reference: memory linear in N.  And
+ * time O(N log N): each level of the tree, at most 8 + 1.3 log2 N of them,
+ * handles at most BUDGET (N + 1) references in linear time, and the events
+ * sorted after the root's are those of cut primitives, two a reference that
+ * the cuts add (a plane through a convex primitive's box cuts the
+ * primitive, so the clip callback keeps it on both sides but for rounding).
+ * 16 leaves every tree of the SPD scenes, the 100k-triangle sphere, the 1M
+ * cube-sphere and test_kdtree's scenes as it was (8 changes the flat one,
+ * whose tree costs 9.6 a primitive); a 50k-triangle fan then builds in
+ * 0.5 s with 0.8M references (8: 0.23 s, 32: 1 s). */
+#ifndef BUDGET
+#define BUDGET 16
+#endif
+
 /* The traversal treats every cell as if it were grown by a margin
  * delta = RAY_EPS * (largest coordinate of the scene box and the ray origin)
  * on every side, and visits every cell whose grown box the ray passes
@@ -433,27 +466,39 @@ static float clampf(float x, float lo, float hi)
  * sweep must have counted what ends at p before it prices p. */
 enum { END = 0, PLANAR = 1, START = 2 };
 
+/* An event in 8 bytes: the position, and in `key` the type (the top 2 bits)
+ * over the primitive's number (the low 30; kd_build takes at most 2^30
+ * primitives).  The events are most of the build's memory: six per
+ * primitive at the root. */
 typedef struct {
     float pos;
-    int type;
-    int prim;
+    uint32_t key;
 } kd_event;
 
-/* The events of one node, one list per axis, each sorted. */
+static uint32_t ev_key(int type, int prim) { return (uint32_t)type << 30 | (uint32_t)prim; }
+static int ev_type(const kd_event *e) { return (int)(e->key >> 30); }
+static int ev_prim(const kd_event *e) { return (int)(e->key & MAX_INDEX); }
+
+/* The events of one node, one list per axis, each sorted.  The root's lists
+ * (and the few fresh events of a split) are blocks of their own: own = 1.
+ * Every other node's lie on the builder's stack (see kd_builder), where
+ * at[] says where; ev[] points there only until the stack moves (it may
+ * move when it grows), and attach() sets it again. */
 typedef struct {
     kd_event *ev[3];
-    long n[3];
+    long at[3], n[3];
     long count;  /* primitives in the node */
+    int own;
 } kd_list;
 
-/* Ties broken by primitive number: a total order gives the same list
- * whatever qsort does with equal keys, so the build is deterministic. */
+/* By position, then type, then primitive number (the key): a total order
+ * gives the same list whatever qsort does with equal keys, so the build is
+ * deterministic. */
 static int event_cmp(const void *pa, const void *pb)
 {
     const kd_event *a = pa, *b = pb;
     if (a->pos != b->pos) return a->pos < b->pos ? -1 : 1;
-    if (a->type != b->type) return a->type - b->type;
-    return (a->prim > b->prim) - (a->prim < b->prim);
+    return (a->key > b->key) - (a->key < b->key);
 }
 
 /* A zero-thickness box gives one PLANAR event instead of a start and an end
@@ -464,16 +509,17 @@ static void add_events(kd_event *ev[3], long n[3], int prim, const kd_box *b)
     for (a = 0; a < 3; a++) {
         kd_event *e = ev[a] + n[a];
         if (b->lo[a] == b->hi[a]) {
-            e[0].pos = b->lo[a], e[0].type = PLANAR, e[0].prim = prim;
+            e[0].pos = b->lo[a], e[0].key = ev_key(PLANAR, prim);
             n[a] += 1;
         } else {
-            e[0].pos = b->lo[a], e[0].type = START, e[0].prim = prim;
-            e[1].pos = b->hi[a], e[1].type = END, e[1].prim = prim;
+            e[0].pos = b->lo[a], e[0].key = ev_key(START, prim);
+            e[1].pos = b->hi[a], e[1].key = ev_key(END, prim);
             n[a] += 2;
         }
     }
 }
 
+/* Only for lists of their own (own = 1). */
 static void free_list(kd_list *L)
 {
     int a;
@@ -488,6 +534,7 @@ static int alloc_list(kd_list *L, long cap)
         L->n[a] = 0;
     }
     L->count = 0;
+    L->own = 1;
     if (L->ev[0] && L->ev[1] && L->ev[2]) return 1;
     free_list(L);
     return 0;
@@ -495,7 +542,9 @@ static int alloc_list(kd_list *L, long cap)
 
 /* ---- the builder -------------------------------------------------------- */
 
-enum { LEFT = 1, RIGHT = 2, BOTH = 3 };
+/* Where a primitive goes when a node is split: LEFT, RIGHT, or BOTH when the
+ * plane cuts it; the cut ones are then numbered 0, 1, ... (see number_cut). */
+enum { LEFT = -1, RIGHT = -2, BOTH = -3 };
 
 typedef struct {
     const prims *p;
@@ -503,10 +552,12 @@ typedef struct {
     long nnodes, node_cap;
     int *refs;
     long nrefs, ref_cap;
-    unsigned char *side;  /* per primitive, while splitting one node */
-    kd_box *cur;          /* per primitive: its box inside that node */
+    int *side;            /* per primitive, while splitting one node */
+    kd_event *stack;      /* the nodes' lists, see split_lists */
+    long top, stack_cap;  /* events in use on the stack, and room */
     int max_depth;
     double root_area;
+    double pool;          /* budget left unspent by finished subtrees */
     kd_info info;
     int failed;           /* out of memory, or more than 2^30 nodes */
 } kd_builder;
@@ -515,6 +566,7 @@ typedef struct {
     int found, axis, planar_left;
     float pos;
     double cost;
+    long nl, nr;  /* primitives on each side, by their boxes */
 } kd_split;
 
 /* Expected cost of cutting v at pos, with nl and nr primitives per side. */
@@ -529,11 +581,13 @@ static double sah(const kd_box *v, int axis, float pos, long nl, long nr,
     return nl == 0 || nr == 0 ? cost * EMPTY_BONUS : cost;
 }
 
-static void offer(kd_split *best, int axis, float pos, double cost, int planar_left)
+static void offer(kd_split *best, int axis, float pos, double cost, int planar_left,
+                  long nl, long nr)
 {
     if (cost < best->cost) {
         best->found = 1, best->axis = axis, best->pos = pos;
         best->cost = cost, best->planar_left = planar_left;
+        best->nl = nl, best->nr = nr;
     }
 }
 
@@ -544,7 +598,8 @@ static void consider(kd_split *best, const kd_box *v, int axis, float pos,
 {
     double left = sah(v, axis, pos, nl + np, nr, area);
     double right = sah(v, axis, pos, nl, np + nr, area);
-    offer(best, axis, pos, left <= right ? left : right, left <= right);
+    if (left <= right) offer(best, axis, pos, left, 1, nl + np, nr);
+    else offer(best, axis, pos, right, 0, nl, np + nr);
 }
 
 /* A plane on a face of the cell, with primitives lying in it: a floor at
@@ -558,9 +613,9 @@ static void consider_face(kd_split *best, const kd_box *v, int axis,
                           float pos, long nl, long np, long nr, double area)
 {
     if (pos == v->lo[axis])
-        offer(best, axis, pos, sah(v, axis, pos, nl + np, nr, area), 1);
+        offer(best, axis, pos, sah(v, axis, pos, nl + np, nr, area), 1, nl + np, nr);
     else
-        offer(best, axis, pos, sah(v, axis, pos, nl, np + nr, area), 0);
+        offer(best, axis, pos, sah(v, axis, pos, nl, np + nr, area), 0, nl, np + nr);
 }
 
 /* Other planes on or within a few float steps of a face of the cell are
@@ -585,9 +640,9 @@ static void sweep(const kd_list *L, int axis, const kd_box *v, double area,
     while (i < n) {
         float pos = e[i].pos;
         long ends = 0, planars = 0, starts = 0;
-        for (; i < n && e[i].pos == pos && e[i].type == END; i++) ends++;
-        for (; i < n && e[i].pos == pos && e[i].type == PLANAR; i++) planars++;
-        for (; i < n && e[i].pos == pos && e[i].type == START; i++) starts++;
+        for (; i < n && e[i].pos == pos && ev_type(&e[i]) == END; i++) ends++;
+        for (; i < n && e[i].pos == pos && ev_type(&e[i]) == PLANAR; i++) planars++;
+        for (; i < n && e[i].pos == pos && ev_type(&e[i]) == START; i++) starts++;
         nr -= ends + planars;
         if (well_inside(pos, v->lo[axis], v->hi[axis]))
             consider(best, v, axis, pos, nl, planars, nr, area);
@@ -604,7 +659,7 @@ static kd_split find_split(const kd_list *L, const kd_box *v)
     double area = box_area(v);
     int a;
     best.found = 0, best.axis = 0, best.planar_left = 1;
-    best.pos = 0, best.cost = HUGE_VAL;
+    best.pos = 0, best.cost = HUGE_VAL, best.nl = best.nr = 0;
     if (!(area > 0)) return best;  /* a line or a point: nothing to cut */
     for (a = 0; a < 3; a++) sweep(L, a, v, area, &best);
     return best;
@@ -617,33 +672,46 @@ static void classify(kd_builder *b, const kd_list *L, const kd_split *s)
 {
     const kd_event *e = L->ev[s->axis];
     long n = L->n[s->axis], i;
-    for (i = 0; i < n; i++) b->side[e[i].prim] = BOTH;
+    for (i = 0; i < n; i++) b->side[ev_prim(&e[i])] = BOTH;
     for (i = 0; i < n; i++) {
-        if (e[i].type == END && e[i].pos <= s->pos)
-            b->side[e[i].prim] = LEFT;
-        else if (e[i].type == START && e[i].pos >= s->pos)
-            b->side[e[i].prim] = RIGHT;
-        else if (e[i].type == PLANAR) {
-            if (e[i].pos < s->pos) b->side[e[i].prim] = LEFT;
-            else if (e[i].pos > s->pos) b->side[e[i].prim] = RIGHT;
-            else b->side[e[i].prim] = s->planar_left ? LEFT : RIGHT;
+        int type = ev_type(&e[i]), *side = &b->side[ev_prim(&e[i])];
+        if (type == END && e[i].pos <= s->pos) *side = LEFT;
+        else if (type == START && e[i].pos >= s->pos) *side = RIGHT;
+        else if (type == PLANAR) {
+            if (e[i].pos < s->pos) *side = LEFT;
+            else if (e[i].pos > s->pos) *side = RIGHT;
+            else *side = s->planar_left ? LEFT : RIGHT;
         }
     }
 }
 
+/* Number the cut primitives 0, 1, ... in the order of their first events
+ * on axis 0, the order cut_events meets them in; side[] then holds the
+ * number, their place in the array of their boxes.  Returns how many. */
+static long number_cut(kd_builder *b, const kd_list *L)
+{
+    long i, k = 0;
+    for (i = 0; i < L->n[0]; i++) {
+        const kd_event *e = &L->ev[0][i];
+        if (ev_type(e) != END && b->side[ev_prim(e)] == BOTH) b->side[ev_prim(e)] = (int)k++;
+    }
+    return k;
+}
+
 /* Read back the box, inside this node, of each primitive that the plane
- * cuts: its events are all there is. */
-static void recall_boxes(kd_builder *b, const kd_list *L)
+ * cuts: its events are all there is.  Boxes are only kept for those, not
+ * for every primitive: at 1M triangles that is 24 MB less. */
+static void recall_boxes(const kd_builder *b, const kd_list *L, kd_box *cut)
 {
     int a;
     long i;
     for (a = 0; a < 3; a++) {
         for (i = 0; i < L->n[a]; i++) {
             const kd_event *e = &L->ev[a][i];
-            kd_box *box = &b->cur[e->prim];
-            if (b->side[e->prim] != BOTH) continue;
-            if (e->type != END) box->lo[a] = e->pos;
-            if (e->type != START) box->hi[a] = e->pos;
+            int k = b->side[ev_prim(e)];
+            if (k < 0) continue;  /* not cut */
+            if (ev_type(e) != END) cut[k].lo[a] = e->pos;
+            if (ev_type(e) != START) cut[k].hi[a] = e->pos;
         }
     }
 }
@@ -656,10 +724,10 @@ static void recall_boxes(kd_builder *b, const kd_list *L)
  * The callback is shown the cell grown by two float steps: a primitive that
  * rounding to nearest put in this cell may lie up to half a step outside
  * it, and must not be dropped for that. */
-static int clip_prim(const kd_builder *b, int prim, const kd_box *cell,
-                     kd_box *out)
+static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
+                     const kd_box *cell, kd_box *out)
 {
-    kd_box old = b->cur[prim];
+    kd_box old = *box;
     int a;
     for (a = 0; a < 3; a++) {
         old.lo[a] = old.lo[a] > cell->lo[a] ? old.lo[a] : cell->lo[a];
@@ -684,13 +752,13 @@ static int clip_prim(const kd_builder *b, int prim, const kd_box *cell,
 
 /* Merge the events of the primitives that went wholly to one side (already
  * sorted) with the fresh events of the cut primitives (sorted here). */
-static void merge(const kd_event *old, long n, const unsigned char *side,
+static void merge(const kd_event *old, long n, const int *side,
                   int want, const kd_event *fresh, long nf, kd_event *out,
                   long *nout)
 {
     long i = 0, j = 0, k = 0;
     for (;;) {
-        while (i < n && side[old[i].prim] != want) i++;
+        while (i < n && side[ev_prim(&old[i])] != want) i++;
         if (i == n) break;
         if (j < nf && event_cmp(&fresh[j], &old[i]) < 0) out[k++] = fresh[j++];
         else out[k++] = old[i++];
@@ -700,24 +768,25 @@ static void merge(const kd_event *old, long n, const unsigned char *side,
 }
 
 /* Events for the cut primitives, clipped to each child: the only events
- * that need sorting after the first sort (Wald & Havran 2006). */
-static int cut_events(kd_builder *b, const kd_list *L, const kd_box *vl,
-                      const kd_box *vr, kd_list *fl, kd_list *fr)
+ * that need sorting after the first sort (Wald & Havran 2006).  cut[k] is
+ * the box of the cut primitive numbered k. */
+static int cut_events(const kd_builder *b, const kd_list *L, const kd_box *cut,
+                      long ncut, const kd_box *vl, const kd_box *vr, kd_list *fl,
+                      kd_list *fr)
 {
     const kd_event *e = L->ev[0];
-    long i, ncut = 0;
+    long i;
     int a;
-    for (i = 0; i < L->n[0]; i++)
-        if (e[i].type != END && b->side[e[i].prim] == BOTH) ncut++;
     if (!alloc_list(fl, 2 * ncut)) return 0;
     if (!alloc_list(fr, 2 * ncut)) return free_list(fl), 0;
     for (i = 0; i < L->n[0]; i++) {
+        int prim = ev_prim(&e[i]), k = b->side[prim];
         kd_box box;
-        if (e[i].type == END || b->side[e[i].prim] != BOTH) continue;
-        if (clip_prim(b, e[i].prim, vl, &box))
-            add_events(fl->ev, fl->n, e[i].prim, &box), fl->count++;
-        if (clip_prim(b, e[i].prim, vr, &box))
-            add_events(fr->ev, fr->n, e[i].prim, &box), fr->count++;
+        if (ev_type(&e[i]) == END || k < 0) continue;
+        if (clip_prim(b, prim, &cut[k], vl, &box))
+            add_events(fl->ev, fl->n, prim, &box), fl->count++;
+        if (clip_prim(b, prim, &cut[k], vr, &box))
+            add_events(fr->ev, fr->n, prim, &box), fr->count++;
     }
     for (a = 0; a < 3; a++) {
         qsort(fl->ev[a], fl->n[a], sizeof(kd_event), event_cmp);
@@ -734,42 +803,115 @@ static long count_side(const kd_builder *b, const kd_list *L, int a, int want,
     long i, k = 0;
     for (i = 0; i < L->n[a]; i++) {
         const kd_event *e = &L->ev[a][i];
-        if (prims_only && e->type == END) continue;
-        k += b->side[e->prim] == want;
+        if (prims_only && ev_type(e) == END) continue;
+        k += b->side[ev_prim(e)] == want;
     }
     return k;
 }
 
+/* Point ev[] at the list's place on the stack, wherever the stack is now. */
+static void attach(const kd_builder *b, kd_list *L)
+{
+    int a;
+    if (!L->own)
+        for (a = 0; a < 3; a++) L->ev[a] = b->stack + L->at[a];
+}
+
+/* Give up a list: free it, or pop it off the stack, whose top it is.  When
+ * the stack is less than half full its tail is handed back, so that the
+ * room the first levels needed is not kept while the tree grows (glibc
+ * returns the pages of a big block that shrinks; at 1M triangles that took
+ * the peak from 104 to 92 bytes a triangle). */
+static void drop(kd_builder *b, kd_list *L)
+{
+    if (L->own) {
+        free_list(L);
+        return;
+    }
+    b->top = L->at[0];
+    if (b->top < b->stack_cap / 2 && b->stack_cap > 65536) {
+        long cap = b->top + b->top / 4 + 1024;
+        kd_event *shrunk = realloc(b->stack, cap * sizeof(kd_event));
+        if (shrunk) b->stack = shrunk, b->stack_cap = cap;
+    }
+}
+
+/* Room on the stack for `need` events.  A quarter more is asked for, so
+ * that it seldom moves; room not yet written to costs address space, not
+ * memory, on systems that map pages as they are first written (Linux and
+ * the BSDs do, for big blocks). */
+static int reserve(kd_builder *b, long need)
+{
+    kd_event *grown;
+    long cap = need + need / 4 + 1024;
+    if (need <= b->stack_cap) return 1;
+    grown = realloc(b->stack, cap * sizeof(kd_event));
+    if (!grown) return 0;
+    b->stack = grown, b->stack_cap = cap;
+    return 1;
+}
+
 /* Split the sorted event lists of a node into sorted lists for its two
  * children in time linear in their length (plus the sort of the few cut
- * primitives). */
-static int split_lists(kd_builder *b, const kd_list *L, const kd_split *s,
+ * primitives).
+ *
+ * Memory.  The lists are most of the build's memory, and the build walks
+ * depth first, so they live on one stack: a node's list is on top when it
+ * is split; its children's lists are written above it, the right child's
+ * below the left's, and then moved down over it.  The left child is built
+ * next and its subtree pops everything it pushed; then the right child's
+ * list is on top.  Nothing is left in holes, as a block for each list
+ * leaves them in the C library's heap (at 1M triangles glibc kept 74 MB of
+ * such holes, resident, to the end of the build).  The root's lists are
+ * blocks of their own, freed axis by axis as the children's are made: the
+ * peak is the root's events and a third more, not twice them. */
+static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
                        const kd_box *vl, const kd_box *vr, kd_list *left,
                        kd_list *right)
 {
     kd_list fl, fr;
-    int a, ok = 1;
+    kd_box *cut;
+    long ncut, nl[3], nr[3], from = b->top, to, total = 0;
+    int a, ok;
     classify(b, L, s);
-    recall_boxes(b, L);
-    if (!cut_events(b, L, vl, vr, &fl, &fr)) return 0;
+    ncut = number_cut(b, L);
+    cut = malloc((ncut + 1) * sizeof(kd_box));
+    if (!cut) return 0;
+    recall_boxes(b, L, cut);
+    ok = cut_events(b, L, cut, ncut, vl, vr, &fl, &fr);
+    free(cut);
+    if (!ok) return 0;
+    left->count = count_side(b, L, 0, LEFT, 1) + fl.count;
+    right->count = count_side(b, L, 0, RIGHT, 1) + fr.count;
     for (a = 0; a < 3; a++) {
-        long nl = count_side(b, L, a, LEFT, 0) + fl.n[a];
-        long nr = count_side(b, L, a, RIGHT, 0) + fr.n[a];
-        left->ev[a] = malloc((nl + 1) * sizeof(kd_event));
-        right->ev[a] = malloc((nr + 1) * sizeof(kd_event));
-        ok = ok && left->ev[a] && right->ev[a];
+        nl[a] = count_side(b, L, a, LEFT, 0) + fl.n[a];
+        nr[a] = count_side(b, L, a, RIGHT, 0) + fr.n[a];
+        total += nl[a] + nr[a];
     }
-    for (a = 0; ok && a < 3; a++) {
+    if (!reserve(b, from + total)) {
+        free_list(&fl), free_list(&fr);
+        return 0;
+    }
+    attach(b, L);
+    for (a = 0, to = from; a < 3; a++) right->at[a] = to, to += nr[a];
+    for (a = 0; a < 3; a++) left->at[a] = to, to += nl[a];
+    left->own = right->own = 0;
+    attach(b, left), attach(b, right);
+    for (a = 0; a < 3; a++) {
         merge(L->ev[a], L->n[a], b->side, LEFT, fl.ev[a], fl.n[a],
               left->ev[a], &left->n[a]);
         merge(L->ev[a], L->n[a], b->side, RIGHT, fr.ev[a], fr.n[a],
               right->ev[a], &right->n[a]);
+        if (L->own) free(L->ev[a]), L->ev[a] = NULL;
     }
-    left->count = count_side(b, L, 0, LEFT, 1) + fl.count;
-    right->count = count_side(b, L, 0, RIGHT, 1) + fr.count;
     free_list(&fl), free_list(&fr);
-    if (!ok) free_list(left), free_list(right);
-    return ok;
+    to = L->own ? from : L->at[0];  /* where the children's lists go */
+    if (to < from) {
+        memmove(b->stack + to, b->stack + from, total * sizeof(kd_event));
+        for (a = 0; a < 3; a++) left->at[a] -= from - to, right->at[a] -= from - to;
+    }
+    b->top = to + total;
+    return 1;
 }
 
 /* ---- nodes and leaves --------------------------------------------------- */
@@ -815,7 +957,7 @@ static void make_leaf(kd_builder *b, long at, const kd_list *L)
         b->refs = grown, b->ref_cap = cap;
     }
     for (i = 0; i < L->n[0]; i++)
-        if (e[i].type != END) b->refs[b->nrefs++] = e[i].prim;
+        if (ev_type(&e[i]) != END) b->refs[b->nrefs++] = ev_prim(&e[i]);
     if (L->count > 1) qsort(b->refs + start, L->count, sizeof(int), int_cmp);
     b->nodes[at].u.count = (uint32_t)L->count;
     b->nodes[at].bits = (uint32_t)start << 2 | LEAF;
@@ -838,48 +980,51 @@ static void note_node(kd_builder *b, const kd_box *v, int depth, long leaf_prims
 }
 
 /* Build the subtree of node `at` over the events L (which it frees) in cell
- * v.  A node becomes a leaf when
+ * v, with `budget` to spend (see BUDGET).  A node becomes a leaf when
  *   - it holds no primitive: nothing to gain;
  *   - it is at the depth limit, 8 + 1.3 log2 N: a guard against piles of
  *     overlapping primitives that no plane separates, where each split would
  *     copy them all to both sides (the rule of thumb of Pharr & Humphreys'
  *     pbrt); it also bounds the traversal's stack;
- *   - no candidate plane lies well inside the cell (see well_inside), or
+ *   - no candidate plane lies well inside the cell (see well_inside);
  *   - the best split costs at least as much as the leaf (COST_TEST * n): the
- *     automatic termination of the SAH (Wald & Havran 2006). */
+ *     automatic termination of the SAH (Wald & Havran 2006), or
+ *   - its budget and the pool cannot pay for the children. */
 static void build_node(kd_builder *b, long at, kd_list *L, const kd_box *v,
-                       int depth)
+                       int depth, double budget)
 {
     kd_split s;
     kd_list left, right;
     kd_box vl = *v, vr = *v;
     long child;
-    s.found = 0;
+    double need, share;
+    attach(b, L);
+    s.found = 0, s.nl = s.nr = 0;
     if (L->count > 0 && depth < b->max_depth) s = find_split(L, v);
-    if (!s.found || s.cost >= COST_TEST * L->count) {
+    need = (double)s.nl + s.nr + 2;  /* what the children would cost */
+    if (!s.found || s.cost >= COST_TEST * L->count || need > budget + b->pool) {
         note_node(b, v, depth, L->count);
         make_leaf(b, at, L);
-        free_list(L);
+        drop(b, L);
+        b->pool += budget - (L->count + 1);
         return;
     }
+    if (need > budget) b->pool -= need - budget, budget = need;
     vl.hi[s.axis] = s.pos;
     vr.lo[s.axis] = s.pos;
     if (!split_lists(b, L, &s, &vl, &vr, &left, &right)) {
         b->failed = 1;
-        free_list(L);
+        drop(b, L);
         return;
     }
-    free_list(L);
     child = new_pair(b);
-    if (child < 0) {
-        free_list(&left), free_list(&right);
-        return;
-    }
+    if (child < 0) return;
     note_node(b, v, depth, -1);
     b->nodes[at].u.split = s.pos;
     b->nodes[at].bits = (uint32_t)child << 2 | (uint32_t)s.axis;
-    build_node(b, child, &left, &vl, depth + 1);
-    build_node(b, child + 1, &right, &vr, depth + 1);
+    share = floor(budget * (left.count + 1) / (left.count + right.count + 2));
+    build_node(b, child, &left, &vl, depth + 1, share);
+    build_node(b, child + 1, &right, &vr, depth + 1, budget - share);
 }
 
 /* The events of all primitives, sorted once: the only full sort. */
@@ -905,16 +1050,18 @@ static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
 }
 
 /* Move nodes and lists into one block: one allocation to free, one range of
- * memory for the traversal, and a single byte string to compare. */
+ * memory for the traversal, and a single byte string to compare.  The
+ * nodes' array is grown to take the lists rather than copied: a copy of
+ * both would be the build's peak of memory. */
 static kd_tree *finish(kd_builder *b, const kd_box *scene)
 {
     kd_tree *t = malloc(sizeof *t);
     size_t nb = b->nnodes * sizeof(kd_node), rb = b->nrefs * sizeof(int);
     int a;
     if (!t) return NULL;
-    t->nodes = malloc(nb + rb);
+    t->nodes = realloc(b->nodes, nb + rb);
     if (!t->nodes) return free(t), NULL;
-    memcpy(t->nodes, b->nodes, nb);
+    b->nodes = NULL;  /* now the tree's */
     t->prims = (int *)(t->nodes + b->nnodes);
     if (rb) memcpy(t->prims, b->refs, rb);
     t->bytes = nb + rb;
@@ -941,19 +1088,20 @@ kd_tree *kd_build(int n, const prims *p)
     memset(&b, 0, sizeof b);
     b.p = p;
     if (n < 0) n = 0;
-    b.side = malloc((size_t)n + 1);
-    b.cur = malloc(((size_t)n + 1) * sizeof(kd_box));
-    if (b.side && b.cur && root_list(&b, n, &L, &scene)) {
+    if (n > (long)MAX_INDEX) return NULL;  /* a primitive's number fits in 30 bits */
+    b.side = malloc(((size_t)n + 1) * sizeof(int));
+    if (b.side && root_list(&b, n, &L, &scene)) {
         b.max_depth = n > 1 ? (int)(8 + 1.3 * log2((double)n)) : 8;
         if (b.max_depth > STACK_SIZE) b.max_depth = STACK_SIZE;
         b.root_area = box_area(&scene);
         b.nodes = malloc(16 * sizeof(kd_node));
         b.node_cap = 16, b.nnodes = 1;
-        if (b.nodes) build_node(&b, 0, &L, &scene, 0);
+        if (b.nodes) build_node(&b, 0, &L, &scene, 0, BUDGET * ((double)L.count + 1));
         else free_list(&L);
+        free(b.stack), b.stack = NULL;
         if (b.nodes && !b.failed) t = finish(&b, &scene);
     }
-    free(b.side), free(b.cur), free(b.nodes), free(b.refs);
+    free(b.side), free(b.stack), free(b.nodes), free(b.refs);
     if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
     return t;
 }
