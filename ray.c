@@ -2208,6 +2208,26 @@ static int check_cone(Scene *s, Where w, const real *x, int mat)
     return 1;
 }
 
+/* A colour or a weight beyond 1e30 would overflow to infinity in a few
+ * products (and infinity times a weight of 0 is NaN), and an index of
+ * refraction beyond 1e6 either way makes refract() cancel two huge terms
+ * and return a direction that is no unit vector: both are refused (the
+ * fuzz targets found NaN pixels from each). */
+#define COLOR_LIMIT 1e30
+static int color_ok(vec c)
+{
+    return fabs(c.x) <= COLOR_LIMIT && fabs(c.y) <= COLOR_LIMIT && fabs(c.z) <= COLOR_LIMIT;
+}
+
+static int material_ok(Where w, const Material *m)
+{
+    if (!(m->ir >= 1e-6 && m->ir <= 1e6))
+        return fail(w, "index of refraction must be between 1e-6 and 1e6", NULL);
+    if (!color_ok(m->color) || !color_ok(v3(m->kd, m->ks, m->kt)) || !(fabs(m->kl) <= COLOR_LIMIT))
+        return fail(w, "colours and weights must lie within 1e30 either way", NULL);
+    return 1;
+}
+
 /* Remembers the first material whose kd + ks + kt exceeds 1, for the path
  * tracer's warning, and the first whose ks + kt does, for Whitted's (its
  * model takes such weights as they are). */
@@ -2226,9 +2246,9 @@ static void note_weights(Scene *s, Where w, const Material *m)
 static int material8(Scene *s, Where w, const real *v, int *mat)
 {
     Material m;
-    if (!(v[7] > 0)) return fail(w, "index of refraction must be positive", NULL);
     m.color = v3(v[0], v[1], v[2]);
     m.kd = v[3]; m.ks = v[4]; m.kt = v[5]; m.kl = v[6]; m.ir = v[7]; m.shine = 0;
+    if (!material_ok(w, &m)) return 0;
     *mat = add_material(s, m);
     note_weights(s, w, &m);
     return 1;
@@ -2290,6 +2310,7 @@ static int point_light(Scene *s, Where w, vec pos, vec color)
                 (double)FAR_LIMIT);
         return fail(w, msg, NULL);
     }
+    if (!color_ok(color)) return fail(w, "a light's colour must lie within 1e30 either way", NULL);
     add_light(s, pos, color, -1);
     return 1;
 }
@@ -2859,6 +2880,7 @@ static int nff_material(Scene *s, Lexer *lx, int *mat)
     m.color = v3(x[0], x[1], x[2]);
     m.kd = x[3]; m.ks = x[4]; m.shine = x[5]; m.kt = x[6]; m.kl = 0;
     m.ir = x[7] > 0 ? x[7] : 1;  /* the SPD files write 0 for opaque materials */
+    if (!material_ok(lx->w, &m)) return 0;
     *mat = add_material(s, m);
     note_weights(s, lx->w, &m);
     return 1;

@@ -168,3 +168,14 @@ assert px('$TMP/normal.ppm', 4, 4) == (128, 0, 128), px('$TMP/normal.ppm', 4, 4)
 ./ray --view heat -o "$TMP/h.ppm" "$TMP/view.sph" 2>"$TMP/err"; rc=$?
 [ $rc = 2 ] && grep -q "steps, normal or depth" "$TMP/err" && ok "--view heat: exit 2, the choices listed" \
   || bad "--view heat: exit $rc"
+
+# Numbers whose products overflow: refused with their file:line (the fuzz
+# targets found NaN pixels from each: a colour of 1e308, an index of 3.3e16).
+printf '0 0 0  1e308 1 1  1  0 0 1 1 1.5\n' > "$TMP/huge.sph"
+./ray -s 4x4 -o "$TMP/h.ppm" "$TMP/huge.sph" 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "huge.sph:1: colours and weights must lie within 1e30" "$TMP/err" \
+  && ok "a colour of 1e308 is refused at its line" || bad "colour 1e308: exit $rc, $(cat "$TMP/err")"
+printf 'v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 8 8\nf 1 1 1 0 0 0 1 3.3e16\ns 0 0 0 1\n' > "$TMP/ior.nff"
+./ray -s 4x4 -o "$TMP/i.ppm" "$TMP/ior.nff" 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "ior.nff:8: index of refraction must be between 1e-6 and 1e6" "$TMP/err" \
+  && ok "an index of refraction of 3.3e16 is refused at its line" || bad "index 3.3e16: exit $rc, $(cat "$TMP/err")"
