@@ -481,14 +481,14 @@ static int ev_prim(const kd_event *e) { return (int)(e->key & MAX_INDEX); }
 
 /* The events of one node, one list per axis, each sorted.  The root's lists
  * (and the few fresh events of a split) are blocks of their own: own = 1.
- * Every other node's lie on the builder's stack (see kd_builder), where
- * at[] says where; ev[] points there only until the stack moves (it may
- * move when it grows), and attach() sets it again. */
+ * Every other node's lie on one of the builder's two stacks (`on`; see
+ * split_lists), where at[] says where; ev[] points there only until the
+ * stack moves (it may move when it grows), and attach() sets it again. */
 typedef struct {
     kd_event *ev[3];
     long at[3], n[3];
     long count;  /* primitives in the node */
-    int own;
+    int own, on;
 } kd_list;
 
 /* By position, then type, then primitive number (the key): a total order
@@ -553,8 +553,8 @@ typedef struct {
     int *refs;
     long nrefs, ref_cap;
     int *side;            /* per primitive, while splitting one node */
-    kd_event *stack;      /* the nodes' lists, see split_lists */
-    long top, stack_cap;  /* events in use on the stack, and room */
+    kd_event *stack[2];   /* the nodes' lists, see split_lists */
+    long top[2], stack_cap[2];  /* events in use on each stack, and room */
     int max_depth;
     double root_area;
     double pool;          /* budget left unspent by finished subtrees */
@@ -809,15 +809,15 @@ static long count_side(const kd_builder *b, const kd_list *L, int a, int want,
     return k;
 }
 
-/* Point ev[] at the list's place on the stack, wherever the stack is now. */
+/* Point ev[] at the list's place on its stack, wherever the stack is now. */
 static void attach(const kd_builder *b, kd_list *L)
 {
     int a;
     if (!L->own)
-        for (a = 0; a < 3; a++) L->ev[a] = b->stack + L->at[a];
+        for (a = 0; a < 3; a++) L->ev[a] = b->stack[L->on] + L->at[a];
 }
 
-/* Give up a list: free it, or pop it off the stack, whose top it is.  When
+/* Give up a list: free it, or pop it off its stack, whose top it is.  When
  * the stack is less than half full its tail is handed back, so that the
  * room the first levels needed is not kept while the tree grows (glibc
  * returns the pages of a big block that shrinks; at 1M triangles that took
@@ -828,26 +828,26 @@ static void drop(kd_builder *b, kd_list *L)
         free_list(L);
         return;
     }
-    b->top = L->at[0];
-    if (b->top < b->stack_cap / 2 && b->stack_cap > 65536) {
-        long cap = b->top + b->top / 4 + 1024;
-        kd_event *shrunk = realloc(b->stack, cap * sizeof(kd_event));
-        if (shrunk) b->stack = shrunk, b->stack_cap = cap;
+    b->top[L->on] = L->at[0];
+    if (b->top[L->on] < b->stack_cap[L->on] / 2 && b->stack_cap[L->on] > 65536) {
+        long cap = b->top[L->on] + b->top[L->on] / 4 + 1024;
+        kd_event *shrunk = realloc(b->stack[L->on], cap * sizeof(kd_event));
+        if (shrunk) b->stack[L->on] = shrunk, b->stack_cap[L->on] = cap;
     }
 }
 
-/* Room on the stack for `need` events.  A quarter more is asked for, so
+/* Room on stack `on` for `need` events.  A quarter more is asked for, so
  * that it seldom moves; room not yet written to costs address space, not
  * memory, on systems that map pages as they are first written (Linux and
  * the BSDs do, for big blocks). */
-static int reserve(kd_builder *b, long need)
+static int reserve(kd_builder *b, int on, long need)
 {
     kd_event *grown;
     long cap = need + need / 4 + 1024;
-    if (need <= b->stack_cap) return 1;
-    grown = realloc(b->stack, cap * sizeof(kd_event));
+    if (need <= b->stack_cap[on]) return 1;
+    grown = realloc(b->stack[on], cap * sizeof(kd_event));
     if (!grown) return 0;
-    b->stack = grown, b->stack_cap = cap;
+    b->stack[on] = grown, b->stack_cap[on] = cap;
     return 1;
 }
 
@@ -856,22 +856,26 @@ static int reserve(kd_builder *b, long need)
  * primitives).
  *
  * Memory.  The lists are most of the build's memory, and the build walks
- * depth first, so they live on one stack: a node's list is on top when it
- * is split; its children's lists are written above it, the right child's
- * below the left's, and then moved down over it.  The left child is built
- * next and its subtree pops everything it pushed; then the right child's
- * list is on top.  Nothing is left in holes, as a block for each list
- * leaves them in the C library's heap (at 1M triangles glibc kept 74 MB of
- * such holes, resident, to the end of the build).  The root's lists are
- * blocks of their own, freed axis by axis as the children's are made: the
- * peak is the root's events and a third more, not twice them. */
+ * depth first, so they live on two stacks, one level of the tree on one,
+ * the next on the other: a node's list is on top of one when it is split;
+ * its children's lists are pushed on the other, the right child's below
+ * the left's, and the node's is popped.  The left child is built next and
+ * its subtree pops everything it pushed; then the right child's list is on
+ * top.  (On one stack the children's lists would have to be moved down
+ * over their parent's, one more pass over them.)  Nothing is left in
+ * holes, as a block for each list leaves them in the C library's heap (at
+ * 1M triangles glibc kept 74 MB of such holes, resident, to the end of the
+ * build).  The root's lists are blocks of their own, freed axis by axis as
+ * the children's are made: the peak is the root's events and a third
+ * more, not twice them. */
 static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
                        const kd_box *vl, const kd_box *vr, kd_list *left,
                        kd_list *right)
 {
     kd_list fl, fr;
     kd_box *cut;
-    long ncut, nl[3], nr[3], from = b->top, to, total = 0;
+    long ncut, nl[3], nr[3], from, to, total = 0;
+    int on = L->own ? 0 : !L->on;  /* the children's lists go on the other stack */
     int a, ok;
     classify(b, L, s);
     ncut = number_cut(b, L);
@@ -888,7 +892,8 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
         nr[a] = count_side(b, L, a, RIGHT, 0) + fr.n[a];
         total += nl[a] + nr[a];
     }
-    if (!reserve(b, from + total)) {
+    from = b->top[on];
+    if (!reserve(b, on, from + total)) {
         free_list(&fl), free_list(&fr);
         return 0;
     }
@@ -896,6 +901,7 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
     for (a = 0, to = from; a < 3; a++) right->at[a] = to, to += nr[a];
     for (a = 0; a < 3; a++) left->at[a] = to, to += nl[a];
     left->own = right->own = 0;
+    left->on = right->on = on;
     attach(b, left), attach(b, right);
     for (a = 0; a < 3; a++) {
         merge(L->ev[a], L->n[a], b->side, LEFT, fl.ev[a], fl.n[a],
@@ -905,12 +911,8 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
         if (L->own) free(L->ev[a]), L->ev[a] = NULL;
     }
     free_list(&fl), free_list(&fr);
-    to = L->own ? from : L->at[0];  /* where the children's lists go */
-    if (to < from) {
-        memmove(b->stack + to, b->stack + from, total * sizeof(kd_event));
-        for (a = 0; a < 3; a++) left->at[a] -= from - to, right->at[a] -= from - to;
-    }
-    b->top = to + total;
+    b->top[on] = from + total;
+    drop(b, L);
     return 1;
 }
 
@@ -1098,10 +1100,10 @@ kd_tree *kd_build(int n, const prims *p)
         b.node_cap = 16, b.nnodes = 1;
         if (b.nodes) build_node(&b, 0, &L, &scene, 0, BUDGET * ((double)L.count + 1));
         else free_list(&L);
-        free(b.stack), b.stack = NULL;
+        free(b.stack[0]), free(b.stack[1]), b.stack[0] = b.stack[1] = NULL;
         if (b.nodes && !b.failed) t = finish(&b, &scene);
     }
-    free(b.side), free(b.stack), free(b.nodes), free(b.refs);
+    free(b.side), free(b.stack[0]), free(b.stack[1]), free(b.nodes), free(b.refs);
     if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
     return t;
 }
