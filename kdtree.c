@@ -501,6 +501,52 @@ static int event_cmp(const void *pa, const void *pb)
     return (a->key > b->key) - (a->key < b->key);
 }
 
+/* Byte d (0 the lowest) of an event's place in event_cmp's order: the key
+ * in bytes 0-3, the position in 4-7, its bits turned so that they order as
+ * the numbers do (-0 taken as +0, as event_cmp takes them). */
+static unsigned event_byte(const kd_event *e, int d)
+{
+    uint32_t u;
+    if (d < 4) return e->key >> 8 * d & 255;
+    memcpy(&u, &e->pos, sizeof u);
+    if (u == 0x80000000u) u = 0;
+    u = u & 0x80000000u ? ~u : u | 0x80000000u;
+    return u >> 8 * (d - 4) & 255;
+}
+
+/* Sort events in event_cmp's order.  Long lists by radix, a byte a pass,
+ * the lowest first, in time linear in their length: qsort's calls of
+ * event_cmp took 40% of the build of a 50k-triangle fan, where almost
+ * every split cuts almost every primitive and their fresh events must all
+ * be sorted.  0 when out of memory. */
+static int sort_events(kd_event *e, long n)
+{
+    kd_event *tmp, *from = e, *to;
+    long count[256], i;
+    int d, k;
+    if (n < 64) {
+        qsort(e, n, sizeof *e, event_cmp);
+        return 1;
+    }
+    to = tmp = malloc(n * sizeof *e);
+    if (!tmp) return 0;
+    for (d = 0; d < 8; d++) {
+        long sum = 0;
+        memset(count, 0, sizeof count);
+        for (i = 0; i < n; i++) count[event_byte(&from[i], d)]++;
+        if (count[event_byte(&from[0], d)] == n) continue;  /* all alike */
+        for (k = 0; k < 256; k++) {
+            long c = count[k];
+            count[k] = sum, sum += c;
+        }
+        for (i = 0; i < n; i++) to[count[event_byte(&from[i], d)]++] = from[i];
+        to = from, from = to == e ? tmp : e;
+    }
+    if (from != e) memcpy(e, from, n * sizeof *e);
+    free(tmp);
+    return 1;
+}
+
 /* A zero-thickness box gives one PLANAR event instead of a start and an end
  * at the same place: the sweep then knows it lies in the plane itself. */
 static void add_events(kd_event *ev[3], long n[3], int prim, const kd_box *b)
@@ -788,10 +834,11 @@ static int cut_events(const kd_builder *b, const kd_list *L, const kd_box *cut,
         if (clip_prim(b, prim, &cut[k], vr, &box))
             add_events(fr->ev, fr->n, prim, &box), fr->count++;
     }
-    for (a = 0; a < 3; a++) {
-        qsort(fl->ev[a], fl->n[a], sizeof(kd_event), event_cmp);
-        qsort(fr->ev[a], fr->n[a], sizeof(kd_event), event_cmp);
-    }
+    for (a = 0; a < 3; a++)
+        if (!sort_events(fl->ev[a], fl->n[a]) || !sort_events(fr->ev[a], fr->n[a])) {
+            free_list(fl), free_list(fr);
+            return 0;
+        }
     return 1;
 }
 
@@ -1047,7 +1094,8 @@ static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
         add_events(L->ev, L->n, i, &box);
         L->count++;
     }
-    for (a = 0; a < 3; a++) qsort(L->ev[a], L->n[a], sizeof(kd_event), event_cmp);
+    for (a = 0; a < 3; a++)
+        if (!sort_events(L->ev[a], L->n[a])) return free_list(L), 0;
     return 1;
 }
 
