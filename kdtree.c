@@ -34,6 +34,8 @@
  * every candidate plane of that node; splitting the node's event lists keeps
  * them sorted, so no level sorts again: only the primitives that the plane
  * cuts get new (clipped) events, and those few are sorted and merged in.
+ * A budget of references (BUDGET) keeps the tree's size linear in N on
+ * every input, fans of slivers included, where the SAH alone is not.
  */
 #include "kdtree.h"
 #include <float.h>
@@ -93,14 +95,12 @@
  *     references + leaves <= BUDGET (N + 1),  nodes < 2 BUDGET (N + 1),
  * and a list holds at most six events a reference: memory linear in N.  And
  * time O(N log N): each level of the tree, at most 8 + 1.3 log2 N of them,
- * handles at most BUDGET (N + 1) references in linear time, and the events
- * sorted after the root's are those of cut primitives, two a reference that
- * the cuts add (a plane through a convex primitive's box cuts the
- * primitive, so the clip callback keeps it on both sides but for rounding).
- * 16 leaves every tree of the SPD scenes, the 100k-triangle sphere, the 1M
- * cube-sphere and test_kdtree's scenes as it was (8 changes the flat one,
- * whose tree costs 9.6 a primitive); a 50k-triangle fan then builds in
- * 0.5 s with 0.8M references (8: 0.23 s, 32: 1 s). */
+ * handles at most BUDGET (N + 1) references in linear time (sorting too:
+ * see sort_events).  16 leaves every tree of the SPD scenes, the
+ * 100k-triangle sphere, the 1M cube-sphere and test_kdtree's scenes as it
+ * was (8 changes the flat one, whose tree costs 9.6 a primitive); a
+ * 50k-triangle fan then builds in 0.38 s with 0.80M references (8: 0.19 s,
+ * 32: 0.78 s). */
 #ifndef BUDGET
 #define BUDGET 16
 #endif
@@ -481,14 +481,14 @@ static int ev_prim(const kd_event *e) { return (int)(e->key & MAX_INDEX); }
 
 /* The events of one node, one list per axis, each sorted.  The root's lists
  * (and the few fresh events of a split) are blocks of their own: own = 1.
- * Every other node's lie on the builder's stack (see kd_builder), where
- * at[] says where; ev[] points there only until the stack moves (it may
- * move when it grows), and attach() sets it again. */
+ * Every other node's lie on one of the builder's two stacks (`on`; see
+ * split_lists), where at[] says where; ev[] points there only until the
+ * stack moves (it may move when it grows), and attach() sets it again. */
 typedef struct {
     kd_event *ev[3];
     long at[3], n[3];
     long count;  /* primitives in the node */
-    int own;
+    int own, on;
 } kd_list;
 
 /* By position, then type, then primitive number (the key): a total order
@@ -499,6 +499,52 @@ static int event_cmp(const void *pa, const void *pb)
     const kd_event *a = pa, *b = pb;
     if (a->pos != b->pos) return a->pos < b->pos ? -1 : 1;
     return (a->key > b->key) - (a->key < b->key);
+}
+
+/* Byte d (0 the lowest) of an event's place in event_cmp's order: the key
+ * in bytes 0-3, the position in 4-7, its bits turned so that they order as
+ * the numbers do (-0 taken as +0, as event_cmp takes them). */
+static unsigned event_byte(const kd_event *e, int d)
+{
+    uint32_t u;
+    if (d < 4) return e->key >> 8 * d & 255;
+    memcpy(&u, &e->pos, sizeof u);
+    if (u == 0x80000000u) u = 0;
+    u = u & 0x80000000u ? ~u : u | 0x80000000u;
+    return u >> 8 * (d - 4) & 255;
+}
+
+/* Sort events in event_cmp's order.  Long lists by radix, a byte a pass,
+ * the lowest first, in time linear in their length: qsort's calls of
+ * event_cmp took 40% of the build of a 50k-triangle fan, where almost
+ * every split cuts almost every primitive and their fresh events must all
+ * be sorted.  0 when out of memory. */
+static int sort_events(kd_event *e, long n)
+{
+    kd_event *tmp, *from = e, *to;
+    long count[256], i;
+    int d, k;
+    if (n < 64) {
+        qsort(e, n, sizeof *e, event_cmp);
+        return 1;
+    }
+    to = tmp = malloc(n * sizeof *e);
+    if (!tmp) return 0;
+    for (d = 0; d < 8; d++) {
+        long sum = 0;
+        memset(count, 0, sizeof count);
+        for (i = 0; i < n; i++) count[event_byte(&from[i], d)]++;
+        if (count[event_byte(&from[0], d)] == n) continue;  /* all alike */
+        for (k = 0; k < 256; k++) {
+            long c = count[k];
+            count[k] = sum, sum += c;
+        }
+        for (i = 0; i < n; i++) to[count[event_byte(&from[i], d)]++] = from[i];
+        to = from, from = to == e ? tmp : e;
+    }
+    if (from != e) memcpy(e, from, n * sizeof *e);
+    free(tmp);
+    return 1;
 }
 
 /* A zero-thickness box gives one PLANAR event instead of a start and an end
@@ -553,8 +599,8 @@ typedef struct {
     int *refs;
     long nrefs, ref_cap;
     int *side;            /* per primitive, while splitting one node */
-    kd_event *stack;      /* the nodes' lists, see split_lists */
-    long top, stack_cap;  /* events in use on the stack, and room */
+    kd_event *stack[2];   /* the nodes' lists, see split_lists */
+    long top[2], stack_cap[2];  /* events in use on each stack, and room */
     int max_depth;
     double root_area;
     double pool;          /* budget left unspent by finished subtrees */
@@ -788,10 +834,11 @@ static int cut_events(const kd_builder *b, const kd_list *L, const kd_box *cut,
         if (clip_prim(b, prim, &cut[k], vr, &box))
             add_events(fr->ev, fr->n, prim, &box), fr->count++;
     }
-    for (a = 0; a < 3; a++) {
-        qsort(fl->ev[a], fl->n[a], sizeof(kd_event), event_cmp);
-        qsort(fr->ev[a], fr->n[a], sizeof(kd_event), event_cmp);
-    }
+    for (a = 0; a < 3; a++)
+        if (!sort_events(fl->ev[a], fl->n[a]) || !sort_events(fr->ev[a], fr->n[a])) {
+            free_list(fl), free_list(fr);
+            return 0;
+        }
     return 1;
 }
 
@@ -809,15 +856,15 @@ static long count_side(const kd_builder *b, const kd_list *L, int a, int want,
     return k;
 }
 
-/* Point ev[] at the list's place on the stack, wherever the stack is now. */
+/* Point ev[] at the list's place on its stack, wherever the stack is now. */
 static void attach(const kd_builder *b, kd_list *L)
 {
     int a;
     if (!L->own)
-        for (a = 0; a < 3; a++) L->ev[a] = b->stack + L->at[a];
+        for (a = 0; a < 3; a++) L->ev[a] = b->stack[L->on] + L->at[a];
 }
 
-/* Give up a list: free it, or pop it off the stack, whose top it is.  When
+/* Give up a list: free it, or pop it off its stack, whose top it is.  When
  * the stack is less than half full its tail is handed back, so that the
  * room the first levels needed is not kept while the tree grows (glibc
  * returns the pages of a big block that shrinks; at 1M triangles that took
@@ -828,26 +875,26 @@ static void drop(kd_builder *b, kd_list *L)
         free_list(L);
         return;
     }
-    b->top = L->at[0];
-    if (b->top < b->stack_cap / 2 && b->stack_cap > 65536) {
-        long cap = b->top + b->top / 4 + 1024;
-        kd_event *shrunk = realloc(b->stack, cap * sizeof(kd_event));
-        if (shrunk) b->stack = shrunk, b->stack_cap = cap;
+    b->top[L->on] = L->at[0];
+    if (b->top[L->on] < b->stack_cap[L->on] / 2 && b->stack_cap[L->on] > 65536) {
+        long cap = b->top[L->on] + b->top[L->on] / 4 + 1024;
+        kd_event *shrunk = realloc(b->stack[L->on], cap * sizeof(kd_event));
+        if (shrunk) b->stack[L->on] = shrunk, b->stack_cap[L->on] = cap;
     }
 }
 
-/* Room on the stack for `need` events.  A quarter more is asked for, so
+/* Room on stack `on` for `need` events.  A quarter more is asked for, so
  * that it seldom moves; room not yet written to costs address space, not
  * memory, on systems that map pages as they are first written (Linux and
  * the BSDs do, for big blocks). */
-static int reserve(kd_builder *b, long need)
+static int reserve(kd_builder *b, int on, long need)
 {
     kd_event *grown;
     long cap = need + need / 4 + 1024;
-    if (need <= b->stack_cap) return 1;
-    grown = realloc(b->stack, cap * sizeof(kd_event));
+    if (need <= b->stack_cap[on]) return 1;
+    grown = realloc(b->stack[on], cap * sizeof(kd_event));
     if (!grown) return 0;
-    b->stack = grown, b->stack_cap = cap;
+    b->stack[on] = grown, b->stack_cap[on] = cap;
     return 1;
 }
 
@@ -856,22 +903,26 @@ static int reserve(kd_builder *b, long need)
  * primitives).
  *
  * Memory.  The lists are most of the build's memory, and the build walks
- * depth first, so they live on one stack: a node's list is on top when it
- * is split; its children's lists are written above it, the right child's
- * below the left's, and then moved down over it.  The left child is built
- * next and its subtree pops everything it pushed; then the right child's
- * list is on top.  Nothing is left in holes, as a block for each list
- * leaves them in the C library's heap (at 1M triangles glibc kept 74 MB of
- * such holes, resident, to the end of the build).  The root's lists are
- * blocks of their own, freed axis by axis as the children's are made: the
- * peak is the root's events and a third more, not twice them. */
+ * depth first, so they live on two stacks, one level of the tree on one,
+ * the next on the other: a node's list is on top of one when it is split;
+ * its children's lists are pushed on the other, the right child's below
+ * the left's, and the node's is popped.  The left child is built next and
+ * its subtree pops everything it pushed; then the right child's list is on
+ * top.  (On one stack the children's lists would have to be moved down
+ * over their parent's, one more pass over them.)  Nothing is left in
+ * holes, as a block for each list leaves them in the C library's heap (at
+ * 1M triangles glibc kept 74 MB of such holes, resident, to the end of the
+ * build).  The root's lists are blocks of their own, freed axis by axis as
+ * the children's are made: the peak is the root's events and a third
+ * more, not twice them. */
 static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
                        const kd_box *vl, const kd_box *vr, kd_list *left,
                        kd_list *right)
 {
     kd_list fl, fr;
     kd_box *cut;
-    long ncut, nl[3], nr[3], from = b->top, to, total = 0;
+    long ncut, nl[3], nr[3], from, to, total = 0;
+    int on = L->own ? 0 : !L->on;  /* the children's lists go on the other stack */
     int a, ok;
     classify(b, L, s);
     ncut = number_cut(b, L);
@@ -888,7 +939,8 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
         nr[a] = count_side(b, L, a, RIGHT, 0) + fr.n[a];
         total += nl[a] + nr[a];
     }
-    if (!reserve(b, from + total)) {
+    from = b->top[on];
+    if (!reserve(b, on, from + total)) {
         free_list(&fl), free_list(&fr);
         return 0;
     }
@@ -896,6 +948,7 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
     for (a = 0, to = from; a < 3; a++) right->at[a] = to, to += nr[a];
     for (a = 0; a < 3; a++) left->at[a] = to, to += nl[a];
     left->own = right->own = 0;
+    left->on = right->on = on;
     attach(b, left), attach(b, right);
     for (a = 0; a < 3; a++) {
         merge(L->ev[a], L->n[a], b->side, LEFT, fl.ev[a], fl.n[a],
@@ -905,12 +958,8 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
         if (L->own) free(L->ev[a]), L->ev[a] = NULL;
     }
     free_list(&fl), free_list(&fr);
-    to = L->own ? from : L->at[0];  /* where the children's lists go */
-    if (to < from) {
-        memmove(b->stack + to, b->stack + from, total * sizeof(kd_event));
-        for (a = 0; a < 3; a++) left->at[a] -= from - to, right->at[a] -= from - to;
-    }
-    b->top = to + total;
+    b->top[on] = from + total;
+    drop(b, L);
     return 1;
 }
 
@@ -1045,7 +1094,8 @@ static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
         add_events(L->ev, L->n, i, &box);
         L->count++;
     }
-    for (a = 0; a < 3; a++) qsort(L->ev[a], L->n[a], sizeof(kd_event), event_cmp);
+    for (a = 0; a < 3; a++)
+        if (!sort_events(L->ev[a], L->n[a])) return free_list(L), 0;
     return 1;
 }
 
@@ -1098,10 +1148,10 @@ kd_tree *kd_build(int n, const prims *p)
         b.node_cap = 16, b.nnodes = 1;
         if (b.nodes) build_node(&b, 0, &L, &scene, 0, BUDGET * ((double)L.count + 1));
         else free_list(&L);
-        free(b.stack), b.stack = NULL;
+        free(b.stack[0]), free(b.stack[1]), b.stack[0] = b.stack[1] = NULL;
         if (b.nodes && !b.failed) t = finish(&b, &scene);
     }
-    free(b.side), free(b.stack), free(b.nodes), free(b.refs);
+    free(b.side), free(b.stack[0]), free(b.stack[1]), free(b.nodes), free(b.refs);
     if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
     return t;
 }
