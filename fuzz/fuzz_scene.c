@@ -91,15 +91,17 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 
 /* kdtree.c keeps its boxes in float, and says that coordinates beyond the
  * float range are clamped to it, and a primitive that reaches out there is
- * not supported; issue 13 found the tree's hits wrong for scenes above about
- * 1e38 or below 1e-41, and --accel none right.  Such a scene (any object's
- * box, the eye or a light beyond 1e37, or a nonzero coordinate of them
- * below 1e-37, where floats lose their precision) is rendered both ways,
- * but the two images are not compared.  Nor are they searched for NaN:
- * beyond 1e154 a squared distance overflows, and issue 13 asks for such
- * scenes to be refused with a true message, not for their pixels; within
- * 1e37 none can, so there a NaN is a bug. */
-static int out_of_range(double x) { return fabs(x) > 1e37 || (x != 0 && fabs(x) < 1e-37); }
+ * not supported: issue 13 found the tree's hits wrong above about 1e38, and
+ * --accel none right (scenes/minray.sph scaled by 1e38: 48% of the channels
+ * differ).  Such a scene (any object's box, the eye or a light beyond 1e37)
+ * is rendered both ways, but the two images are not compared.  Nor are they
+ * searched for NaN: beyond 1e154 a squared distance overflows, and issue 13
+ * asks for such scenes to be refused with a true message, not for their
+ * pixels; within 1e37 none can, so there a NaN is a bug.  (Issue 13 also
+ * saw the tree wrong for scenes below 1e-41; scenes/demo.nff and minray.sph
+ * scaled down to 1e-44 render the same both ways today, and so the tiny are
+ * compared: if that fails again, the fuzzer will say so.) */
+static int out_of_range(double x) { return fabs(x) > 1e37; }
 
 static int beyond_float_range(Scene *s)
 {
