@@ -12,8 +12,8 @@
  * MAX_LIGHTS lights, so that no input takes long):
  *   - by Whitted's tracer through the kd-tree and through the loop over every
  *     object (--accel kd and none): the two images must be the same, bit for
- *     bit in floats (the PFM output; the same bytes follow), as the tests
- *     check whole pixels; and no NaN;
+ *     bit in floats (what -o x.pfm writes), as the tests check whole pixels;
+ *     and no NaN;
  *   - by the path tracer (at most 8 rays a path): no NaN in its output.
  * The floats are checked, not the bytes: to_byte turns a NaN into a quiet
  * black, and agreeing bytes can hide a small difference.

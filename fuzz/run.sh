@@ -29,7 +29,13 @@ for f in "$@"; do
   if [ "$rc" != 0 ]; then
     status=1
     echo "fuzz_$f: FOUND SOMETHING (exit $rc); from $log:"
-    grep -E 'ERROR|SUMMARY|fuzz_scene:|Test unit written|==[0-9]+==|deadly signal|timeout' "$log" | head -n 20 | sed 's/^/    /'
+    grep -E 'ERROR|SUMMARY|Test unit written|deadly signal|timeout' "$log" | head -n 20 | sed 's/^/    /'
+    # the input once more, with stderr: the reader's message, what differs, the sanitizer's report
+    unit=$(sed -n 's/.*Test unit written to //p' "$log" | tail -n 1)
+    if [ -f "$unit" ]; then
+      echo "fuzz_$f: $target $unit says:"
+      "$target" "$unit" 2>&1 | grep -vE '^(INFO|Running|Executed|\*\*\*)' | head -n 30 | sed 's/^/    /'
+    fi
   fi
 done
 exit $status
