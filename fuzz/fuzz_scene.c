@@ -132,10 +132,15 @@ static int beyond_float_range(Scene *s)
  *      highlight at the next hit makes pow(huge, shine) = inf, then NaN.
  *   3. nan_huge: a colour, weight or light near the largest double (1e308)
  *      overflows to inf in the sums, and inf times 0 is NaN.
- * (2 and 3 are numbers the readers should refuse; the pixels go black.) */
+ *   4. cone_flat: a cone whose length is below the rounding error of its
+ *      heights (1e-71 against radii of 0.3) is hit where it has no surface
+ *      (at the eye, outside its rim); the tree, whose box leaves out some of
+ *      those points, then differs from the loop.
+ * (2 to 4 are numbers the readers should refuse; the pixels go black.) */
 #ifdef FUZZ_KNOWN_BUGS
 static int known_bug_in_path_tracer(const Scene *s) { (void)s; return 0; }
 static int known_nan(const Scene *s) { (void)s; return 0; }
+static int known_difference(const Scene *s) { (void)s; return 0; }
 #else
 static int known_bug_in_path_tracer(const Scene *s)
 {
@@ -157,6 +162,16 @@ static int known_nan(const Scene *s)
         const Material *m = &s->mat[i];
         if (huge(m->color) || huge(v3(m->kd, m->ks, m->kt)) || fabs(m->kl) > 1e37
             || !(fabs(m->ir) >= 1e-6 && fabs(m->ir) <= 1e6)) return 1;
+    }
+    return 0;
+}
+
+static int known_difference(const Scene *s)
+{
+    int i;
+    for (i = 0; i < s->ncone; i++) {
+        const Cone *c = &s->cone[i];
+        if (c->len < 1e-9 * (fmax(c->rb, c->ra) + maxabs(c->base))) return 1;
     }
     return 0;
 }
@@ -237,7 +252,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     Image tree, loop, path;
     char scene[128];
     size_t k;
-    int in_range, check_nan;
+    int in_range, check_nan, compare;
 #if FORMAT == SPH
     if (names_a_path(data, size)) return 0;
     write_file("in.sph", data, size);
@@ -265,6 +280,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (s.depth > DEPTH) s.depth = DEPTH;
     in_range = !beyond_float_range(&s);
     check_nan = in_range && !known_nan(&s);
+    compare = in_range && !known_difference(&s);
 
     /* Whitted's, through the tree and through the loop */
     s.integrator = WHITTED;
@@ -273,7 +289,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     s.accel = ACCEL_NONE;
     render_tiny(&s, &loop, "Whitted, loop", check_nan);
     s.accel = ACCEL_KD;
-    for (k = 0; k < (size_t)3 * SIZE * SIZE && in_range; k++)
+    for (k = 0; k < (size_t)3 * SIZE * SIZE && compare; k++)
         if (memcmp(&tree.floats[k], &loop.floats[k], sizeof *tree.floats) != 0) {
             fprintf(stderr, "fuzz_scene: pixel (%d, %d) channel %d: %.9g through the kd-tree, "
                     "%.9g through the loop\n", (int)(k / 3 % SIZE), (int)(k / 3 / SIZE),
