@@ -5,7 +5,8 @@
 # make golf     the code-golf leaderboard (see golf/)
 # make spd      the seven SPD scenes at the benchmark's sizes, generated into scenes/spd/
 # make fuzz     libFuzzer on the scene readers (clang; fuzz/): builds build/fuzz/fuzz_sph,
-#               fuzz_nff and fuzz_obj and runs each FUZZ_SECONDS (60; FUZZ_SECONDS=600 for longer)
+#               fuzz_nff and fuzz_obj and runs each FUZZ_SECONDS (60; FUZZ_SECONDS=600 for longer;
+#               FUZZ_SEED=N for libFuzzer's -seed)
 # make clean
 CC     ?= cc
 CFLAGS ?= -O2
@@ -71,7 +72,7 @@ build/fuzz/seeds.made: $(wildcard scenes/*.sph scenes/*.nff scenes/*.obj fuzz/se
 	touch $@
 
 fuzz: $(FUZZ_FORMATS:%=build/fuzz/fuzz_%) build/fuzz/seeds.made
-	@FUZZ_SECONDS=$(FUZZ_SECONDS) bash fuzz/run.sh $(FUZZ_FORMATS)
+	@FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_SEED=$(FUZZ_SEED) bash fuzz/run.sh $(FUZZ_FORMATS)
 
 test: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/run.sh

@@ -11,15 +11,20 @@
 # than 10 s is written to build/fuzz/FORMAT-crash-* (or -timeout-, -oom-,
 # -slow-unit-) and fails the run; rerun the target on that file to see why:
 #     build/fuzz/fuzz_sph build/fuzz/sph-crash-...
+#
+# FUZZ_SEED=N fixes libFuzzer's random numbers (-seed=N): CI does, so that on
+# the same code it makes the same inputs, and a finding there can be had again.
 cd "$(dirname "$0")/.." || exit 2
 secs=${FUZZ_SECONDS:-60}
+seed=${FUZZ_SEED:+-seed=$FUZZ_SEED}
 status=0
 for f in "$@"; do
   target=build/fuzz/fuzz_$f corpus=build/fuzz/corpus-$f log=build/fuzz/$f.log
   if [ ! -x "$target" ]; then echo "fuzz: $target is not built (make fuzz builds it)"; status=2; continue; fi
   mkdir -p "$corpus"
   echo "fuzz_$f: ${secs} s from $(ls build/fuzz/seeds-$f | wc -l) seeds and $(ls "$corpus" | wc -l) inputs of earlier runs, dictionary fuzz/$f.dict"
-  "$target" -max_total_time="$secs" -timeout=10 -max_len=8192 -close_fd_mask=2 \
+  # shellcheck disable=SC2086 # $seed is empty or one word
+  "$target" -max_total_time="$secs" $seed -timeout=10 -max_len=8192 -close_fd_mask=2 \
     -dict="fuzz/$f.dict" -artifact_prefix="build/fuzz/$f-" -print_final_stats=1 \
     "$corpus" "build/fuzz/seeds-$f" >"$log" 2>&1
   rc=$?
