@@ -54,9 +54,7 @@ FORMAT_sph = SPH
 FORMAT_nff = NFF
 FORMAT_obj = OBJ
 
-# FUZZ_KNOWN_BUGS=1: trip the bugs that fuzz/crashes-found/ reports (to check a fix).
-FUZZ_DEFS = $(if $(FUZZ_KNOWN_BUGS),-DFUZZ_KNOWN_BUGS)
-FUZZ_BUILD = $(FUZZ_CC) $(FUZZ_CFLAGS) $(FUZZ_DEFS)
+FUZZ_BUILD = $(FUZZ_CC) $(FUZZ_CFLAGS)
 
 # the compiler and flags of the last build: the targets are rebuilt when they change
 build/fuzz/flags: FORCE
