@@ -66,8 +66,14 @@
 # Knobs (environment; defaults keep `make bench` near BENCH_MINUTES minutes of
 # CPU on 2 cores):
 #   BENCH_PARTS="render spd build rays accel anim pov pt"
-#   BENCH_ROUNDS=3           rounds of turns between programs (ours and Embree,
-#                            ours and POV-Ray, kd and none, the animation's)
+#   BENCH_ROUNDS=3           rounds of turns between programs (ours and Embree
+#                            in the accel section, ours and POV-Ray, kd and
+#                            none, the animation's)
+#   BENCH_RAYS_ROUNDS=5      rounds of Embree and ours in the rays section (its
+#                            runs are short, and random rays through a mesh
+#                            slow down by a quarter, CPU time and all, while
+#                            another process shares the cache: one round of
+#                            three did so in a run on the busy machine)
 #   BENCH_SPP="1 4 16"       sample counts to time
 #   BENCH_REF_SPP=64         reference sample count (should exceed the above)
 #   BENCH_FLAKE_LEVEL=4      sphereflake recursion (4: 7381 spheres)
@@ -129,6 +135,7 @@ MESHES=${BENCH_MESHES:-sphere100k teapot_s12}
 RAYS_RES=${BENCH_RAYS_RES:-1024}
 RAYS_N=${BENCH_RAYS_N:-1000000}
 ROUNDS=${BENCH_ROUNDS:-3}
+RAYS_ROUNDS=${BENCH_RAYS_ROUNDS:-5}
 OUT=bench/out
 
 die() { echo "bench/run.sh: $*" >&2; exit 1; }
@@ -174,10 +181,10 @@ done
 for n in $SPPS; do
   [ "$n" -lt "$REF_SPP" ] || die "BENCH_REF_SPP ($REF_SPP) must exceed every count in BENCH_SPP ($SPPS)"
 done
-for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N $ROUNDS; do
-  case $n in ''|*[!0-9]*|0) die "BENCH_NONE_BUDGET, BENCH_BUILD_MAX, BENCH_RAYS_RES, BENCH_RAYS_N and BENCH_ROUNDS must be whole numbers from 1, not '$n'";; esac
+for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N $ROUNDS $RAYS_ROUNDS; do
+  case $n in ''|*[!0-9]*|0) die "BENCH_NONE_BUDGET, BENCH_BUILD_MAX, BENCH_RAYS_RES, BENCH_RAYS_N, BENCH_ROUNDS and BENCH_RAYS_ROUNDS must be whole numbers from 1, not '$n'";; esac
 done
-[ "$ROUNDS" -le 9 ] || die "BENCH_ROUNDS must be at most 9, not $ROUNDS"
+[ "$ROUNDS" -le 9 ] || die "BENCH_ROUNDS must be at most 9 (raybench anim's limit), not $ROUNDS"
 for p in $PARTS; do
   case $p in render|spd|build|rays|accel|anim|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim pov pt)";; esac
 done
@@ -651,7 +658,7 @@ if part rays; then
   {
     echo "Traversal, one thread: ray.c's nearest_hit() (tree walk, triangle test, hit point and normals) on ${RAYS_RES}x${RAYS_RES}"
     echo "primary and $RAYS_N random rays; 'walk': kd_nearest() and then the triangle's u, v and unnormalised Ng, which is what"
-    echo "rtcIntersect1 returns (triangle, t, u, v, Ng), no more and no less.  Mrays/s by thread CPU time; $ROUNDS rounds, in"
+    echo "rtcIntersect1 returns (triangle, t, u, v, Ng), no more and no less.  Mrays/s by thread CPU time; $RAYS_ROUNDS rounds, in"
     echo "each 5 runs of each (walk and nearest_hit taking turns), the round's figure their median; the table: the median of"
     echo "the rounds' figures and (least-greatest)."
     if [ -n "$embree" ]; then
@@ -688,7 +695,7 @@ if part rays; then
     # same drift.
     rc=0
     : >"$log"
-    for ((round = 1; round <= ROUNDS; round++)); do
+    for ((round = 1; round <= RAYS_ROUNDS; round++)); do
       if [ -n "$embree" ]; then
         say "rays: $mname: Embree (round $round)"
         elog=$OUT/embree-$mname-$round.log
@@ -758,7 +765,7 @@ if part rays; then
       if [ "$mname" = sphere100k ] && [ "$kind" = primary ]; then
         if [ -n "$emb" ]; then
           # shellcheck disable=SC2086
-          targets+=("primary rays, sphere100k, one thread, CPU time, median of $ROUNDS rounds taking turns: walk (triangle, t, u, v, Ng) $(printf %.2f "$m_walk") Mrays/s ($(range %.2f $walk)), Embree rtcIntersect1 $e_med Mrays/s $e_rng, ratio $r_med $r_rng (target >= 0.5): $(verdict "$r_med >= 0.5"); with nearest_hit's hit point, normal and material $(printf %.2f "$m_ours") Mrays/s, ratio $rr_med")
+          targets+=("primary rays, sphere100k, one thread, CPU time, median of $RAYS_ROUNDS rounds taking turns: walk (triangle, t, u, v, Ng) $(printf %.2f "$m_walk") Mrays/s ($(range %.2f $walk)), Embree rtcIntersect1 $e_med Mrays/s $e_rng, ratio $r_med $r_rng (target >= 0.5): $(verdict "$r_med >= 0.5"); with nearest_hit's hit point, normal and material $(printf %.2f "$m_ours") Mrays/s, ratio $rr_med")
         else
           targets+=("primary rays, sphere100k: walk $(printf %.2f "$m_walk") Mrays/s, nearest_hit $(printf %.2f "$m_ours") Mrays/s (CPU time); Embree $embree_why")
         fi
@@ -1077,6 +1084,7 @@ if part pt; then
     status=1
   fi
   echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
+  echo | tee -a "$OUT/bench.txt"
 fi
 
 # ---------------------------------------------------------------- targets
