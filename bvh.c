@@ -58,19 +58,35 @@
 #define SAH_DEPTH 64
 #define STACK_SIZE 96
 
-/* The margin.  Boxes are floats rounded outwards, so each holds its
- * primitives' double boxes whole.  The walk then treats every box as grown
- * by delta = BVH_EPS * (largest coordinate of the scene and the ray origin)
- * on every side, for two reasons.  The hit callback's point may lie outside
- * the primitive's box by up to 1e-7 of that coordinate (prims.h).  And the
- * slab test runs in float: b - o rounds by 2^-24 of |b - o| <= 2 * scale,
- * d to float, 1/d and the product by 2^-24 each, so a computed crossing
- * may be off by 4 * 2^-24 * 2 * scale = 4.8e-7 * scale in space.  Together
- * 5.8e-7; 2^-20 = 9.5e-7 covers them with room.  The origin shifted by delta is rounded
- * away from the box (see setup_ray), so its own rounding only adds margin.
- * The float test is valid while the numbers stay well inside the float
- * range (FAST_MAX below); other rays are answered by testing every
- * primitive. */
+/* The frame.  Boxes are floats relative to a centre c near the middle of
+ * the scene box (see frame), not to the origin, so that a float step is
+ * 2^-23 of the scene's size wherever the scene lies; they are rounded
+ * outwards, so each holds its primitives' double boxes whole (give or take
+ * the rounding of x - c in double, 2^-53 ext).
+ *
+ * The margin.  The walk treats every box as grown on every side by
+ *     delta = BVH_EPS * ext + ulps * m,
+ * ext the largest |coordinate| of the scene box in the frame, m the largest
+ * |coordinate| of the scene box and of the ray origin in the caller's.
+ * The hit callback's point may lie outside its primitive's box by
+ * PRIMS_HIT_REL of the box's longest side (at most 2 ext) plus
+ * PRIMS_HIT_ULPS eps m (the contract of prims.h).  The slab test runs in
+ * float in the frame, from an origin within 2 ext of the frame's centre
+ * (setup_ray moves a farther one along the ray to where it enters the
+ * grown scene box): b - o rounds by 2^-24 of |b - o| <= 3 ext, d to float,
+ * 1/d and the product by 2^-24 each, so a computed crossing may be off by
+ * 4 * 2^-24 * 3 ext = 7.2e-7 ext in space.  With the callback's
+ * 2 * 2^-24 ext, 8.3e-7 ext; BVH_EPS = 2^-20 = 9.5e-7 covers them.  The
+ * origin shifted by delta is rounded away from the box (see setup_ray), so
+ * its own rounding only adds margin.  The origin moved along the ray,
+ * o - c + t0 d, is summed exactly and rounded once (see moved), so it
+ * lies on the ray to within a rounding of a number of the scene's size;
+ * the walk's t is then the caller's t less t0, and the best hit's t is
+ * taken there in double (exact when t0 is more than half of it) before it
+ * is rounded up to a float.  So the one part of size m is the callback's,
+ * and ulps = PRIMS_HIT_ULPS eps.  The float test is valid while the
+ * numbers stay well inside the float range (FAST_MAX below); other rays
+ * are answered by testing every primitive. */
 #define BVH_EPS (1.0 / 1048576.0)
 #define FAST_MAX 0x1p60
 #define FAST_MIN 0x1p-60
@@ -112,7 +128,11 @@ struct bvh {
     long nnodes, nprims;
     void *block;       /* the allocation behind nodes and prims */
     size_t bytes;
-    double scale;      /* largest |coordinate| of the root's boxes */
+    double c[3];       /* the frame: boxes are relative to c (see BVH_EPS) */
+    double lo[3], hi[3];  /* the root's boxes together, in the frame */
+    double ext;        /* largest |coordinate| of the root's boxes in the frame */
+    double scale;      /* largest |coordinate| of the root's boxes in the caller's coordinates */
+    double ulps;       /* the margin's factor of m: PRIMS_HIT_ULPS eps (see BVH_EPS) */
     bvh_info info;
 };
 
@@ -135,7 +155,9 @@ static float up(double x)
 
 /* ---- traversal ---------------------------------------------------------- */
 
-/* The ray as the slab test needs it.  For each axis, neg picks the box
+/* The ray as the slab test needs it, in the frame, its origin moved by
+ * toff along it when it started far away (see setup_ray): the walk's t is
+ * the caller's t - toff.  For each axis, neg picks the box
  * corner the ray meets first (from the sign bit, so -0 counts as negative
  * like its 1/d = -inf).  on and of are the origin moved by delta: the near
  * plane of a box grown by delta is at b - delta (b + delta for neg), and
@@ -147,6 +169,7 @@ typedef struct {
     float on[3], of[3], inv[3];
     int neg[3];
     float tmin;
+    double toff;
     int skip;
 } bvh_ray;
 
@@ -157,32 +180,79 @@ typedef struct {
     float entry;
 } bvh_todo;
 
-/* The ray set up for the float slab test: 1, or 0 when its numbers leave
- * the test's range (see BVH_EPS), or -1 for NaN or infinite input. */
-static int setup_ray(const bvh *t, const double org[3], const double dir[3],
-                     int skip, double tmin, bvh_ray *r)
+/* o - c + t d, each step exact and the sum rounded once: Knuth's TwoSum
+ * for the sums, and for the product Dekker's split by a fused multiply-add
+ * (the exact product's rounding error is fma(t, d, -t d)).  Rounded step
+ * by step, an origin 1e13 away would land off the ray by 1e-3; this way
+ * it lands within a rounding of where it lands, a number of the scene's
+ * size.  (kdtree.c's moved is the same.) */
+static double moved(double o, double c, double t, double d)
 {
-    double scale = t->scale, dmax = 0, delta;
+    double s = o - c, z = s - o, e = (o - (s - z)) + (-c - z);         /* s + e = o - c */
+    double p = t * d, pe = fma(t, d, -p);                              /* p + pe = t d */
+    double s2 = s + p, z2 = s2 - s, e2 = (s - (s2 - z2)) + (p - z2);   /* s2 + e2 = s + p */
+    return s2 + (e + e2 + pe);
+}
+
+/* The ray set up for the float slab test: 1, or 0 when its numbers leave
+ * the test's range (see BVH_EPS), or -1 when it can hit nothing: NaN or
+ * infinite input, or a ray from far away that misses the scene box.  The
+ * origin goes into the frame; one farther than 2 ext from its centre is
+ * moved along the ray to where the ray enters the grown scene box (the
+ * slab test of Kay and Kajiya 1986, in double), so that the float test
+ * sees numbers of the scene's size: from 1e13 away a float would hold the
+ * origin only to 1e6. */
+static int setup_ray(const bvh *t, const double org[3], const double dir[3],
+                     int skip, double tmin, double tmax, bvh_ray *r)
+{
+    double scale = t->scale, dmax = 0, delta, o[3], far = 0;
     int a;
     for (a = 0; a < 3; a++) {
-        double o = fabs(org[a]), d = fabs(dir[a]);
-        if (!(o <= DBL_MAX && d <= DBL_MAX)) return -1;
-        if (o > scale) scale = o;
+        double m = fabs(org[a]), d = fabs(dir[a]);
+        if (!(m <= DBL_MAX && d <= DBL_MAX)) return -1;
+        if (m > scale) scale = m;
         if (d > dmax) dmax = d;
+        o[a] = org[a] - t->c[a];
+        if (fabs(o[a]) > far) far = fabs(o[a]);
     }
     r->skip = skip;
     if (!(scale <= FAST_MAX && scale >= FAST_MIN && dmax <= FAST_MAX && dmax >= FAST_MIN))
         return 0;
-    delta = BVH_EPS * scale;
+    delta = BVH_EPS * t->ext + t->ulps * scale;
+    r->toff = 0;
+    if (far > 2 * t->ext) {
+        double t0 = tmin, t1 = tmax;
+        for (a = 0; a < 3; a++) {
+            double lo = t->lo[a] - delta - o[a], hi = t->hi[a] + delta - o[a], inv, ta, tb;
+            if (dir[a] == 0) {
+                if (!(lo <= 0 && hi >= 0)) return -1;
+                continue;
+            }
+            inv = 1 / dir[a];
+            ta = lo * inv, tb = hi * inv;
+            if (ta > tb) inv = ta, ta = tb, tb = inv;
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+        }
+        if (!(t0 <= t1)) return -1;
+        r->toff = t0;
+        for (a = 0; a < 3; a++) o[a] = moved(org[a], t->c[a], t0, dir[a]);
+    }
     for (a = 0; a < 3; a++) {
         int neg = signbit(dir[a]) != 0;
         r->neg[a] = neg;
-        r->on[a] = neg ? down(org[a] - delta) : up(org[a] + delta);
-        r->of[a] = neg ? up(org[a] + delta) : down(org[a] - delta);
+        r->on[a] = neg ? down(o[a] - delta) : up(o[a] + delta);
+        r->of[a] = neg ? up(o[a] + delta) : down(o[a] - delta);
         r->inv[a] = 1.0f / (float)dir[a];    /* +-inf for +-0 and tiny d */
     }
-    r->tmin = down(tmin);
+    r->tmin = down(tmin - r->toff);
     return 1;
+}
+
+/* The caller's t as the walk's float t, rounded up. */
+static float walk_t(const bvh_ray *r, double t)
+{
+    return up(t - r->toff);
 }
 
 /* Intersect(ray, object) for each primitive of a leaf.  Nearest: keep the
@@ -262,9 +332,9 @@ static int bvh_intersect(const bvh *t, const prims *p, const bvh_ray *r,
     if (node.count)
         return test_leaf(t, node.index, node.count, p, r, ray, tmin, any, best_t, best,
                          &c->tests);
-    n = children(&t->nodes[node.index], r, up(*best_t), child);
+    n = children(&t->nodes[node.index], r, walk_t(r, *best_t), child);
     for (k = 0; k < n; k++) {
-        if (k > 0 && !(child[k].entry <= up(*best_t))) break;
+        if (k > 0 && !(child[k].entry <= walk_t(r, *best_t))) break;
         best = bvh_intersect(t, p, r, ray, tmin, any, child[k], best_t, best, c);
         if (any && best >= 0) break;
     }
@@ -279,7 +349,7 @@ static int walk(const bvh *t, const prims *p, const bvh_ray *r, void *ray,
                 double tmin, int any, double *best_t, prim_counters *c)
 {
     bvh_todo stack[3 * STACK_SIZE], node, child[4];
-    float tmax = up(*best_t);
+    float tmax = walk_t(r, *best_t);
     unsigned long long steps = 0, tests = 0;
     int n = 0, best = -1;
     node.index = 0, node.count = 0;
@@ -298,7 +368,7 @@ static int walk(const bvh *t, const prims *p, const bvh_ray *r, void *ray,
                              &tests);
             if (best != was) {
                 if (any) break;
-                tmax = up(*best_t);
+                tmax = walk_t(r, *best_t);
             }
         }
         while (n > 0 && !(stack[n - 1].entry <= tmax)) n--;
@@ -318,7 +388,7 @@ static int query(const bvh *t, const prims *p, const double org[3],
     int a;
     if (c) c->rays++;
     if (!t || t->nnodes == 0 || !(tmin <= *best_t)) return -1;
-    a = setup_ray(t, org, dir, skip, tmin, &r);
+    a = setup_ray(t, org, dir, skip, tmin, *best_t, &r);
     if (a < 0) return -1;
     if (a == 0) {
         /* out of the float test's range (see BVH_EPS): every primitive */
@@ -393,19 +463,53 @@ static double box_area(const bvh_box *b)
     return 2 * (dx * dy + dy * dz + dz * dx);
 }
 
-/* Primitive i's box from the callback, rounded outwards to floats: it holds
- * the double box whole.  0 for NaN or lo > hi. */
-static int prim_box(const prims *p, int i, bvh_box *b)
+/* Primitive i's box from the callback, in the frame centred on c, rounded
+ * outwards to floats: it holds the double box whole.  0 for NaN or
+ * lo > hi. */
+static int prim_box(const prims *p, int i, const double c[3], bvh_box *b)
 {
     double lo[3], hi[3];
     int a;
     p->bounds(p->user, i, lo, hi);
     for (a = 0; a < 3; a++) {
         if (!(lo[a] <= hi[a])) return 0;
-        b->lo[a] = down(lo[a]);
-        b->hi[a] = up(hi[a]);
+        b->lo[a] = down(lo[a] - c[a]);
+        b->hi[a] = up(hi[a] - c[a]);
     }
     return 1;
+}
+
+/* The frame's centre for primitives 0..n-1: the middle of their box in the
+ * caller's coordinates, rounded to a multiple of the largest power of two
+ * not above the box's longest side.  Coordinates relative to it are then at
+ * most that side in magnitude (the rounding moves it by at most half the
+ * side), and a scene about the origin gets c = 0 and the very tree it had
+ * in the caller's coordinates.  A box of no size (one point) is centred on
+ * itself; one that is not finite keeps the origin.  (kdtree.c's frame does
+ * the same.) */
+static void frame(const prims *p, int n, double c[3])
+{
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, side = 0, unit = 0;
+    int i, a, e, any = 0;
+    for (i = 0; i < n; i++) {
+        double l[3], h[3];
+        p->bounds(p->user, i, l, h);
+        for (a = 0; a < 3; a++)
+            if (!(l[a] <= h[a])) break;
+        if (a < 3) continue;
+        for (a = 0; a < 3; a++) {
+            if (!any || l[a] < lo[a]) lo[a] = l[a];
+            if (!any || h[a] > hi[a]) hi[a] = h[a];
+        }
+        any = 1;
+    }
+    for (a = 0; a < 3; a++)
+        if (hi[a] - lo[a] > side) side = hi[a] - lo[a];
+    if (side > 0 && side <= DBL_MAX) frexp(side, &e), unit = ldexp(1.0, e - 1);
+    for (a = 0; a < 3; a++) {
+        double mid = 0.5 * lo[a] + 0.5 * hi[a];
+        c[a] = !(side <= DBL_MAX) || !isfinite(mid) ? 0 : unit > 0 ? unit * floor(mid / unit + 0.5) : mid;
+    }
 }
 
 static void node_box(bvh_node *nd, const bvh_box *b)
@@ -437,6 +541,7 @@ typedef struct {
 typedef struct {
     const prims *p;
     int method;
+    double c[3];          /* the frame (see BVH_EPS) */
     bvh_ref *ref;
     bvh_node *nodes;
     long nnodes;
@@ -774,17 +879,24 @@ static double tree_cost4(const bvh *t)
     return sum;
 }
 
+/* The scene box (the root's lanes together) in the frame, and its largest
+ * coordinate there and in the caller's coordinates. */
 static void set_scale(bvh *t)
 {
-    int a, s, k;
-    t->scale = 0;
+    int a, k;
+    bvh_box root, box;
+    t->scale = t->ext = 0;
+    for (a = 0; a < 3; a++) t->lo[a] = t->hi[a] = 0;
     if (t->nnodes == 0) return;
+    box_empty(&root);
     for (k = 0; k < 4; k++)
-        for (s = 0; s < 2; s++)
-            for (a = 0; a < 3; a++) {
-                float x = t->nodes[0].box[s][a][k];
-                if (!lane_empty(&t->nodes[0], k) && fabs(x) > t->scale) t->scale = fabs(x);
-            }
+        if (!lane_empty(&t->nodes[0], k)) lane_to_box(&t->nodes[0], k, &box), box_grow(&root, &box);
+    for (a = 0; a < 3; a++) {
+        if (!(root.lo[a] <= root.hi[a])) return;   /* nothing in the tree */
+        t->lo[a] = root.lo[a], t->hi[a] = root.hi[a];
+        t->ext = fmax(t->ext, fmax(fabs(t->lo[a]), fabs(t->hi[a])));
+        t->scale = fmax(t->scale, fmax(fabs(t->c[a] + t->lo[a]), fabs(t->c[a] + t->hi[a])));
+    }
 }
 
 /* The tree in one block, the nodes aligned to 64 bytes. */
@@ -814,6 +926,8 @@ static bvh *finish(bvh_builder *b, const int *ids, long nprims)
     t->bytes = (size_t)used * sizeof(bvh_node4) + (size_t)nprims * sizeof(int);
     if (nprims) memcpy(t->nodes + used, ids, (size_t)nprims * sizeof(int));
     t->prims = (int *)(t->nodes + used);
+    memcpy(t->c, b->c, sizeof t->c);
+    t->ulps = PRIMS_HIT_ULPS * (b->p->eps > 0 ? b->p->eps : DBL_EPSILON);
     set_scale(t);
     t->info.nodes = used;
     t->info.leaves = b->leaves;
@@ -833,7 +947,7 @@ static long gather(bvh_builder *b, int n)
     int i;
     for (i = 0; i < n; i++) {
         bvh_box box;
-        if (!prim_box(b->p, i, &box)) continue;
+        if (!prim_box(b->p, i, b->c, &box)) continue;
         memcpy(b->ref[m].lo, box.lo, sizeof box.lo);
         memcpy(b->ref[m].hi, box.hi, sizeof box.hi);
         b->ref[m].id = i, b->ref[m].pad = 0;
@@ -856,6 +970,7 @@ bvh *bvh_build(int n, const prims *p, int method)
     b.nodes = calloc(2 * (size_t)n + 2, sizeof *b.nodes);
     ids = malloc(((size_t)n + 1) * sizeof *ids);
     if (b.ref && b.nodes && ids) {
+        frame(p, n, b.c);
         m = gather(&b, n);
         if (m > 0) {
             bvh_box box, cbox;
@@ -886,7 +1001,7 @@ void bvh_refit(bvh *t, const prims *p)
             if (lane_empty(nd, k)) continue;
             box_empty(&box);
             for (m = 0; m < nd->count[k]; m++)
-                if (prim_box(p, t->prims[nd->index[k] + m], &c)) box_grow(&box, &c);
+                if (prim_box(p, t->prims[nd->index[k] + m], t->c, &c)) box_grow(&box, &c);
             for (j = 0; nd->count[k] == 0 && j < 4; j++) {
                 lane_to_box(&t->nodes[nd->index[k]], j, &c);
                 box_grow(&box, &c);
@@ -919,7 +1034,7 @@ long bvh_planes(const bvh *t, int *axis, double *pos, long max)
         for (k = 0; k < 4; k++)
             for (s = 0; s < 2 && !lane_empty(&t->nodes[i], k); s++)
                 for (a = 0; a < 3; a++) {
-                    if (n < max) axis[n] = a, pos[n] = t->nodes[i].box[s][a][k];
+                    if (n < max) axis[n] = a, pos[n] = t->c[a] + t->nodes[i].box[s][a][k];
                     n++;
                 }
     return n;

@@ -10,11 +10,11 @@
  * scene's box allows (an axis along which the box is flat gets one cell).
  *
  * Exactness.  A plain DDA visits the cells the ray passes through.  A hit
- * point may lie a little outside its primitive's box (prims.h allows 1e-7
- * of the largest coordinate), and so in a cell that does not list it; like
- * the kd-tree (kdtree.c, RAY_EPS), the walk therefore treats every cell as
- * grown by delta = RAY_EPS * (largest coordinate of the scene and the ray
- * origin).  It visits every cell whose grown box the ray passes through, in
+ * point may lie a little outside its primitive's box (the contract of
+ * prims.h), and so in a cell that does not list it; like the kd-tree
+ * (kdtree.c, RAY_EPS), the walk therefore treats every cell as grown by a
+ * margin delta (see RAY_EPS below).  It visits every cell whose grown box
+ * the ray passes through, in
  * the order the ray enters them: per axis it keeps the range of cell
  * indices that a cube of half-side delta around the ray's point overlaps.
  * The leading end of a range moving on is Amanatides & Woo's step (it
@@ -43,10 +43,26 @@
  * are made coarser, halving each side until they do not. */
 #define MAX_REFS 16
 
-/* The margin, as in kdtree.c: four times the float rounding that the
- * contract of prims.h allows (1e-7), so the DDA's own double rounding
- * (about 1e-16 of the same coordinates) is far inside it. */
+/* The margin:
+ *     delta = RAY_EPS * ext + WALK_ULPS DBL_EPSILON * s + ulps * m,
+ * ext half the longest side of the scene box, s the largest |coordinate| of
+ * the scene box, m the largest of the scene box and of the ray origin.
+ * The hit callback's point may lie outside its primitive's box by
+ * PRIMS_HIT_REL of the box's longest side (at most 2 ext) plus
+ * PRIMS_HIT_ULPS eps m (the contract of prims.h): ulps = PRIMS_HIT_ULPS
+ * eps, and the first is inside RAY_EPS ext, as in kdtree.c.  The grid has
+ * no floats and keeps the caller's coordinates: its faces lo + i w, the
+ * cells of a point, floor((x - lo) / w), and the DDA's crossings
+ * (face - o) / d are doubles, a few roundings each of numbers below 2s +
+ * 2 ext (a point and its cell may disagree by as much), which WALK_ULPS
+ * DBL_EPSILON s covers.  That is why an origin farther than 3 ext from the
+ * box's middle is first moved along the ray to where the ray enters the
+ * box, the sum o + t0 d taken exactly and rounded once (see moved): then
+ * o is of the scene's size too, and the walk's t is the caller's t less
+ * t0.  A scene far from the origin makes its coordinates' rounding no
+ * worse than the callback's own. */
 #define RAY_EPS 2.5e-7
+#define WALK_ULPS 8
 
 /* Each ray keeps the last primitive tested in each of MAILBOX slots chosen
  * by the primitive's number (Amanatides & Woo 1987): an object in several
@@ -64,6 +80,10 @@ struct grid {
     int res[3];
     double hi[3];                  /* the scene box's far corner */
     double scale;                  /* largest |coordinate| of the scene box */
+    double ext;                    /* half the longest side of the scene box */
+    double mid[3];                 /* the scene box's middle */
+    double fixed;                  /* the margin's parts of the scene (see RAY_EPS) */
+    double ulps;                   /* and its factor of m: PRIMS_HIT_ULPS eps */
     double narrow;                 /* the narrowest cell side (of axes cut in two or more) */
     uint32_t *start;               /* cell c lists list[start[c] .. start[c+1]) */
     int *list;
@@ -80,6 +100,7 @@ typedef struct {
     double o[3], d[3], inv[3];
     int flat[3];
     double delta;
+    double toff;            /* how far along the ray o was moved: the walk's t is the caller's less toff */
     double t0, t1;          /* the ray inside the grid's grown box */
     int lo[3], hi[3];       /* cells overlapped by the grown point, per axis */
     int skip;
@@ -97,37 +118,64 @@ static double face(const grid *g, int a, int i)
     return g->lo[a] + i * g->w[a];
 }
 
+/* o + t d, each step exact and the sum rounded once: Knuth's TwoSum for
+ * the sum, and for the product Dekker's split by a fused multiply-add (the
+ * exact product's rounding error is fma(t, d, -t d)).  Rounded step by
+ * step, an origin 1e13 away would land off the ray by 1e-3; this way it
+ * lands within a rounding of where it lands.  (kdtree.c's moved is the
+ * same, less a centre.) */
+static double moved(double o, double t, double d)
+{
+    double p = t * d, pe = fma(t, d, -p);                              /* p + pe = t d */
+    double s = o + p, z = s - o, e = (o - (s - z)) + (p - z);          /* s + e = o + p */
+    return s + (e + pe);
+}
+
 /* Clip the ray to the grid's box grown by delta (the slab test); 0 when it
- * misses it, or when its numbers are out of range for the walk. */
+ * misses it, or when its numbers are out of range for the walk.  An origin
+ * from far away is moved first (see RAY_EPS), to where the ray enters the
+ * box by the same test on the unmoved origin. */
 static int setup_ray(const grid *g, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, grid_ray *r)
 {
-    double scale = g->scale, dmax = 0, t0 = tmin, t1 = tmax;
-    int a;
+    double scale = g->scale, dmax = 0, t0 = tmin, t1 = tmax, far = 0, o[3];
+    int a, pass, move;
     for (a = 0; a < 3; a++) {
         if (fabs(org[a]) > scale) scale = fabs(org[a]);
         if (fabs(dir[a]) > dmax) dmax = fabs(dir[a]);
+        if (fabs(org[a] - g->mid[a]) > far) far = fabs(org[a] - g->mid[a]);
+        o[a] = org[a];
     }
-    r->delta = RAY_EPS * scale;
+    r->delta = g->fixed + g->ulps * scale;
+    r->toff = 0;
     r->skip = skip;
     for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
-    for (a = 0; a < 3; a++) {
-        double lo = g->lo[a] - r->delta, hi = g->hi[a] + r->delta, ta, tb;
-        r->o[a] = org[a], r->d[a] = dir[a];
-        r->flat[a] = !(fabs(dir[a]) > FLAT * dmax);
-        if (r->flat[a]) {
-            r->inv[a] = 0;
-            if (!(org[a] >= lo && org[a] <= hi)) return 0;
-            continue;
+    move = far > 3 * g->ext;
+    for (pass = move; pass >= 0; pass--) {
+        if (pass == 0 && move) {            /* from far away: move the origin to t0 */
+            for (a = 0; a < 3; a++) o[a] = moved(org[a], r->toff, dir[a]);
+            t0 = tmin - r->toff, t1 = tmax - r->toff;
         }
-        r->inv[a] = 1 / dir[a];
-        ta = (lo - org[a]) * r->inv[a], tb = (hi - org[a]) * r->inv[a];
-        if (ta > tb) { double s = ta; ta = tb; tb = s; }
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
+        for (a = 0; a < 3; a++) {
+            double lo = g->lo[a] - r->delta, hi = g->hi[a] + r->delta, ta, tb;
+            r->o[a] = o[a], r->d[a] = dir[a];
+            r->flat[a] = !(fabs(dir[a]) > FLAT * dmax);
+            if (r->flat[a]) {
+                r->inv[a] = 0;
+                if (!(o[a] >= lo && o[a] <= hi)) return 0;
+                continue;
+            }
+            r->inv[a] = 1 / dir[a];
+            ta = (lo - o[a]) * r->inv[a], tb = (hi - o[a]) * r->inv[a];
+            if (ta > tb) { double s = ta; ta = tb; tb = s; }
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+        }
+        if (!(t0 <= t1)) return 0;
+        if (pass == 1) r->toff = t0;
     }
     r->t0 = t0, r->t1 = t1;
-    return t0 <= t1;
+    return 1;
 }
 
 /* The time the range of axis a next gains a cell (lead) or loses one
@@ -218,7 +266,7 @@ static int walk(const grid *g, const prims *p, grid_ray *r, void *ray, double tm
             lag[al] = lag_time(g, r, al);
             continue;
         }
-        if (!(lead[as] <= r->t1) || *best_t < lead[as]) break;
+        if (!(lead[as] <= r->t1) || *best_t - r->toff < lead[as]) break;
         if (r->d[as] > 0) r->hi[as]++;     /* step: a new slab of cells */
         else r->lo[as]--;
         memcpy(lo, r->lo, sizeof lo), memcpy(hi, r->hi, sizeof hi);
@@ -392,11 +440,15 @@ static long scene_box(grid *g, int n, const prims *p, int *all)
         }
         all[m++] = i;
     }
-    g->scale = 0;
+    g->scale = g->ext = 0;
     for (a = 0; a < 3; a++) {
         if (fabs(g->lo[a]) > g->scale) g->scale = fabs(g->lo[a]);
         if (fabs(g->hi[a]) > g->scale) g->scale = fabs(g->hi[a]);
+        if (0.5 * (g->hi[a] - g->lo[a]) > g->ext) g->ext = 0.5 * (g->hi[a] - g->lo[a]);
+        g->mid[a] = 0.5 * g->lo[a] + 0.5 * g->hi[a];
     }
+    g->fixed = RAY_EPS * g->ext + WALK_ULPS * DBL_EPSILON * g->scale;
+    g->ulps = PRIMS_HIT_ULPS * (p->eps > 0 ? p->eps : DBL_EPSILON);
     return m;
 }
 

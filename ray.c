@@ -1605,12 +1605,51 @@ static int watertight_inside(vec a, vec b, vec c, const Ray *r)
  *    (-DREAL=float) the rounding of u and v grows with the ray's distance
  *    beyond 1e-7 of det (a mesh seen from afar showed holes), so there the
  *    margin also covers a bound on that: 96 ulps of |o - v0| |d| |e|.
+ * And one for rays from afar.  From D times its size away, o - v0 is
+ * rounded by eps D, and the cross and dot products of it with the edges
+ * cancel: t, u and v err by eps D divided by the sines of the grazing angle
+ * and of the triangle's smallest angle (from 10^13 away, by more than the
+ * triangle's size, and the mesh leaks).  The acceleration structures need
+ * the hit point within a few eps of |o| of the triangle's box (prims.h), so
+ * a ray from farther than FAR_TRI times the triangle's size is first moved
+ * along itself to the point nearest v0, as hit_sphere and hit_cone move
+ * theirs, exactly (see from_near); the test is made from there, and the
+ * distance moved added to t.  u and v are then exact to the triangle's own
+ * rounding, t to a rounding of itself, and the hit point o + t d lies
+ * within a few eps of |o| of the triangle.  Rays that fall within the 1e-7
+ * of an edge still get the exact test from the caller's own origin, which
+ * every triangle around the edge shares: the mesh stays watertight.
+ * Nearer rays take the lecture's path unchanged.
  * Returns 1 and t, u, v (barycentrics of v1 and v2) on a hit. */
+#define FAR_TRI 4096
+
+/* o + t d - v, the sum o + t d taken exactly (Knuth's TwoSum, and the
+ * product's rounding error from a fused multiply-add, as Dekker's
+ * TwoProduct) and rounded once, after v is taken off.  For a point of the
+ * ray near v, the result is exact to a rounding of itself.  Rounded step
+ * by step, the point would lie off the ray by a rounding of |o| (1e-3 from
+ * 1e13 away), and a test made from there would see a ray shifted sideways
+ * by that much. */
+static real from_near(real o, real t, real d, real v)
+{
+    real p = t * d, pe, s, z, e;
+    if (sizeof(real) == sizeof(float))
+        pe = (real)((double)t * d - p);     /* exact: a product of floats fits a double */
+    else {                                  /* Dekker: Veltkamp's halves multiply exactly */
+        double c = 134217729.0 * t, th = c - (c - t), tl = t - th, dh, dl;
+        c = 134217729.0 * d, dh = c - (c - d), dl = d - dh;
+        pe = (real)(((th * dh - p) + th * dl + tl * dh) + tl * dl);
+    }
+    s = o + p, z = s - o, e = (o - (s - z)) + (p - z);
+    return (s - v) + (e + pe);
+}
+
 static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
                         real *t, real *u, real *v)
 {
     vec v0 = tr->v0, e1 = tr->e1, e2 = tr->e2, p = cross(r->d, e2), tv, q;
-    real det = dot(e1, p), sign = det < 0 ? -1 : 1, slack, uu, vv, tt;
+    real det = dot(e1, p), sign = det < 0 ? -1 : 1, slack, uu, vv, tt, t0 = 0, size;
+    int far;
     if (tr->degenerate || isnan(det)) return 0;
     if (tr->cull) {                      /* the lecture's culling branch */
         if (!(det > 0)) return 0;
@@ -1619,18 +1658,25 @@ static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real t
     det *= sign;                         /* from here on det > 0 */
     tv = sub(r->o, v0);                   /* u, v and t, each times det */
     slack = (real)1e-7 * det;
+    size = maxabs(e1) + maxabs(e2);
+    far = maxabs(tv) > FAR_TRI * size;
+    if (far) {                           /* see above: from afar, start near v0 */
+        t0 = -dot(tv, r->d) / dot(r->d, r->d);
+        tv = v3(from_near(r->o.x, t0, r->d.x, v0.x), from_near(r->o.y, t0, r->d.y, v0.y),
+                from_near(r->o.z, t0, r->d.z, v0.z));
+    }
     if (sizeof(real) == sizeof(float))   /* see above: float's rounding outgrows 1e-7 */
-        slack += 96 * REAL_EPS * maxabs(tv) * maxabs(r->d) * (maxabs(e1) + maxabs(e2));
+        slack += 96 * REAL_EPS * maxabs(tv) * maxabs(r->d) * size;
     uu = sign * dot(tv, p);
     if (uu < -slack || uu > det + slack) return 0;
     q = cross(tv, e1);
     vv = sign * dot(r->d, q);
     if (vv < -slack || uu + vv > det + slack) return 0;
     tt = sign * dot(e2, q);
-    if (!(tt > 0)) return 0;             /* behind the origin, or NaN */
+    if (far ? !(t0 + tt / det > 0) : !(tt > 0)) return 0;   /* behind the origin, or NaN */
     if ((uu < 0 || vv < 0 || uu + vv > det)
         && !watertight_inside(v0, s->vert[tr->v[1]], s->vert[tr->v[2]], r)) return 0;
-    *t = tt / det;      /* compared after the division: a tie at tmax must be exact */
+    *t = far ? t0 + tt / det : tt / det;   /* compared after the division: a tie at tmax must be exact */
     if (!(*t <= tmax) || (r->tmin > 0 && !(*t > r->tmin))) return 0;
     *u = uu / det;
     *v = vv / det;
@@ -3644,6 +3690,7 @@ static int build_accel(Scene *s, const char *accel)
     s->prims.clip = prim_clip;
     s->prims.hit = prim_hit;
     s->prims.user = s;
+    s->prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
     s->accel = ACCEL_NONE;
     if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
     if (!float_range(s)) {

@@ -136,41 +136,70 @@ static void random_dir(double d[3])
 
 /* ---- the primitives and their callbacks -------------------------------- */
 
+static double maxabs3(const double a[3])
+{
+    return fmax(fabs(a[0]), fmax(fabs(a[1]), fabs(a[2])));
+}
+
 /* Triangle: the three edge tests share their products with the neighbour
  * across each edge (b x c = -(c x b) exactly), so no ray slips between two
- * triangles; hits on edges and vertices count (closed triangles). */
+ * triangles; hits on edges and vertices count (closed triangles).
+ * prims.h asks that the hit point lie within a few eps of the largest
+ * coordinate of the triangle's box; from far away (the far checks) the
+ * products of the far vectors v - o would cancel and amplify their
+ * rounding, so a ray from more than 4096 times the triangle's size away is
+ * first moved along itself to the point nearest v0 (t0 is added back).
+ * Nearer rays, among them every exact ray of the dyadic scenes, are tested
+ * from their own origin. */
 static int hit_tri(const prim *t, const ray *r, double tmin, double tmax,
                    double *out)
 {
-    double a[3], b[3], c[3], w0, w1, w2, den, num, th;
+    double a[3], b[3], c[3], o[3], e[3], w0, w1, w2, den, num, th, t0 = 0;
+    int k;
     den = dot(t->n, r->d);
     if (den == 0) return 0;  /* parallel to the plane, or lying in it */
     sub(t->v[0], r->o, a);
+    sub(t->v[1], t->v[0], b), sub(t->v[2], t->v[0], e);
+    memcpy(o, r->o, sizeof o);
+    if (maxabs3(a) > 4096 * (maxabs3(b) + maxabs3(e))) {
+        t0 = dot(a, r->d) / dot(r->d, r->d);
+        for (k = 0; k < 3; k++) o[k] = r->o[k] + t0 * r->d[k];
+        sub(t->v[0], o, a);
+    }
     num = dot(t->n, a);
-    if (tmin >= 0 && !(num > 0 ? den > 0 : num < 0 && den < 0))
+    if (t0 == 0 && tmin >= 0 && !(num > 0 ? den > 0 : num < 0 && den < 0))
         return 0;  /* t <= 0 <= tmin, known without the division */
-    th = num / den;
+    th = t0 + num / den;
     if (!(th > tmin && th <= tmax && th < HUGE_VAL)) return 0;  /* not at infinity */
-    sub(t->v[1], r->o, b), sub(t->v[2], r->o, c);
+    sub(t->v[1], o, b), sub(t->v[2], o, c);
     w0 = triple(r->d, b, c), w1 = triple(r->d, c, a), w2 = triple(r->d, a, b);
     if ((w0 < 0 || w1 < 0 || w2 < 0) && (w0 > 0 || w1 > 0 || w2 > 0)) return 0;
     *out = th;
     return 1;
 }
 
+/* Sphere: the roots of a t^2 + 2 B t + C = 0 from q and C / q, the
+ * discriminant from the point of the line nearest the centre (Haines et
+ * al., Ray Tracing Gems, ch. 7), so that a far ray's t is exact to a few
+ * eps of its distance, as prims.h asks; the textbook B^2 - a C loses every
+ * digit there. */
 static int hit_sphere(const prim *s, const ray *r, double tmin, double tmax,
                       double *out)
 {
-    double oc[3], a, b, c, disc, root, th;
-    sub(r->o, s->v[0], oc);
+    double f[3], l[3], a, B, C, disc, q, th, t1, rad = s->v[1][0];
+    int k;
+    sub(r->o, s->v[0], f);
     a = dot(r->d, r->d);
-    b = dot(oc, r->d);
-    c = dot(oc, oc) - s->v[1][0] * s->v[1][0];
-    disc = b * b - a * c;
-    if (disc < 0 || a == 0) return 0;
-    root = sqrt(disc);
-    th = (-b - root) / a;
-    if (!(th > tmin && th <= tmax)) th = (-b + root) / a;
+    if (a == 0) return 0;
+    B = dot(f, r->d);
+    for (k = 0; k < 3; k++) l[k] = f[k] - B / a * r->d[k];   /* nearest point, from the centre */
+    disc = a * (rad * rad - dot(l, l));                       /* B^2 - a C */
+    if (!(disc >= 0)) return 0;
+    C = dot(f, f) - rad * rad;
+    q = -B - (B >= 0 ? sqrt(disc) : -sqrt(disc));
+    th = q / a, t1 = q != 0 ? C / q : th;
+    if (th > t1) q = th, th = t1, t1 = q;
+    if (!(th > tmin && th <= tmax)) th = t1;
     if (!(th > tmin && th <= tmax && th < HUGE_VAL)) return 0;
     *out = th;
     return 1;
@@ -1149,7 +1178,7 @@ int main(int argc, char **argv)
                 "soup|mesh|grid|thirds|same|flat|empty|one [rays]\n");
         return 2;
     }
-    p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s;
+    p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s, p.eps = 0;
     t = build(A, s.n, &p);
     if (!t) {
         report(0, "the build returned NULL", s.name, A->name);
