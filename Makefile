@@ -4,6 +4,9 @@
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)
 # make spd      the seven SPD scenes at the benchmark's sizes, generated into scenes/spd/
+# make fuzz     libFuzzer on the scene readers (clang; fuzz/): builds build/fuzz/fuzz_sph,
+#               fuzz_nff and fuzz_obj and runs each FUZZ_SECONDS (60; FUZZ_SECONDS=600 for longer;
+#               FUZZ_SEED=N for libFuzzer's -seed)
 # make clean
 CC     ?= cc
 CFLAGS ?= -O2
@@ -41,6 +44,38 @@ scenes/spd/%.nff: tools/spd
 	@mkdir -p scenes/spd
 	tools/spd $(subst _s, ,$*) >$@.tmp && mv $@.tmp $@
 
+# The fuzz targets: fuzz/fuzz_scene.c compiled once per format.
+FUZZ_CC      ?= clang
+FUZZ_CFLAGS  ?= -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+                -fno-omit-frame-pointer
+FUZZ_SECONDS ?= 60
+FUZZ_FORMATS  = sph nff obj
+FORMAT_sph = SPH
+FORMAT_nff = NFF
+FORMAT_obj = OBJ
+
+FUZZ_BUILD = $(FUZZ_CC) $(FUZZ_CFLAGS)
+
+# the compiler and flags of the last build: the targets are rebuilt when they change
+build/fuzz/flags: FORCE
+	@mkdir -p build/fuzz
+	@echo '$(FUZZ_BUILD)' | cmp -s - $@ || echo '$(FUZZ_BUILD)' >$@
+
+build/fuzz/fuzz_%: fuzz/fuzz_scene.c ray.c kdtree.c kdtree.h bvh.c bvh.h grid.c grid.h prims.h build/fuzz/flags
+	$(FUZZ_BUILD) -DFORMAT=$(FORMAT_$*) -o $@ fuzz/fuzz_scene.c kdtree.c bvh.c grid.c -lm
+
+# The seed corpora, build/fuzz/seeds-FORMAT: scenes/ and fuzz/seeds/, and for
+# NFF the SPD scenes at size 1 (gears, too big at 19 kB, left out).
+build/fuzz/seeds.made: $(wildcard scenes/*.sph scenes/*.nff scenes/*.obj fuzz/seeds/*) tools/spd
+	rm -rf $(FUZZ_FORMATS:%=build/fuzz/seeds-%)
+	mkdir -p $(FUZZ_FORMATS:%=build/fuzz/seeds-%)
+	for f in $(FUZZ_FORMATS); do cp scenes/*.$$f fuzz/seeds/*.$$f build/fuzz/seeds-$$f/; done
+	for db in balls mount rings teapot tetra tree; do tools/spd $$db 1 >build/fuzz/seeds-nff/spd_$$db.nff; done
+	touch $@
+
+fuzz: $(FUZZ_FORMATS:%=build/fuzz/fuzz_%) build/fuzz/seeds.made
+	@FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_SEED=$(FUZZ_SEED) bash fuzz/run.sh $(FUZZ_FORMATS)
+
 test: all
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash tests/run.sh
 
@@ -53,5 +88,7 @@ bench: all spd
 clean:
 	rm -rf $(PROGS) build bench/out scenes/spd
 
-.PHONY: all test stress bench clean golf spd
+FORCE:
+
+.PHONY: all test stress bench clean golf spd fuzz FORCE
 -include golf/golf.mk

@@ -415,8 +415,17 @@ static void insert(const grid *g, const prims *p, int i, const double lo[3],
                 at[0] = x, at[1] = y, at[2] = z;
                 if (p->clip && (c0[0] < c1[0] || c0[1] < c1[1] || c0[2] < c1[2])) {
                     double blo[3], bhi[3], clo[3], chi[3];
-                    for (a = 0; a < 3; a++)
-                        blo[a] = face(g, a, at[a]), bhi[a] = face(g, a, at[a] + 1);
+                    /* The first and last cells along an axis are grown to
+                     * the primitive's own box: cell_of rounds, and faces
+                     * lo + i w round too (the last can fall short of the
+                     * scene box's far side), so a flat primitive lying on a
+                     * face could otherwise be cut off from every cell. */
+                    for (a = 0; a < 3; a++) {
+                        blo[a] = face(g, a, at[a]);
+                        bhi[a] = face(g, a, at[a] + 1);
+                        if (at[a] == c0[a] && lo[a] < blo[a]) blo[a] = lo[a];
+                        if (at[a] == c1[a] && hi[a] > bhi[a]) bhi[a] = hi[a];
+                    }
                     if (!p->clip(p->user, i, blo, bhi, clo, chi)) continue;
                 }
                 add_ref(L, ((long)z * g->res[1] + y) * g->res[0] + x, i);

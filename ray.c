@@ -2250,6 +2250,12 @@ static int check_cone(Scene *s, Where w, const real *x, int mat)
         return fail(w, "cone radii must be >= 0 and not both 0", NULL);
     if (!(dot(sub(apex, base), sub(apex, base)) > 0))
         return fail(w, "cone base and apex coincide", NULL);
+    /* Shorter than this, the rounding of a point's height along the axis
+     * exceeds the length itself, and the side would be found where it is
+     * not (the fuzz targets found one 1e-71 long, hit at the eye). */
+    if (!(sqrt(dot(sub(apex, base), sub(apex, base)))
+          >= 1e-9 * (fmax(x[3], x[7]) + maxabs(base) + maxabs(apex))))
+        return fail(w, "cone shorter than 1e-9 of its radius and coordinates", NULL);
     add_cone(s, base, x[3], apex, x[7], mat);
     return 1;
 }

@@ -7,9 +7,14 @@
 # while ./ray and the scene are unchanged), then each estimator (bsdf, nee,
 # mis) at 1, 4, 16, 64 and 256 samples per pixel on one thread, each run's
 # CPU time (user + system, of the whole process) against its RMSE on
-# linear values (bench/pfmerr.c).  The fitted slope of log RMSE against
-# log time is printed per estimator: -0.5 for an unbiased estimator whose
-# error is noise.  Plotted, log-log, to bench/out/pt.svg.
+# linear values (bench/pfmerr.c).  The three estimators take turns (bsdf
+# nee mis bsdf nee mis ...) in BENCH_PT_ROUNDS rounds at each sample count;
+# the time is the median of the rounds, printed with the least and the
+# greatest (the image, of a fixed seed, is the same each time).  The fitted
+# slope of log RMSE against log time is printed per estimator: -0.5 for an
+# unbiased estimator whose error is noise.  Plotted, log-log, to
+# bench/out/pt.svg.  Every comparison below takes turns too, and its ratio
+# is the median of the rounds' ratios, with their range.
 #
 # Targets, each printed with its figures:
 #   - Cornell box: MIS reaches the RMSE of BSDF sampling at 256 spp in at
@@ -23,7 +28,8 @@
 #     renderer's on the same scene (smallpt's), one thread.
 #
 # Knobs: BENCH_PT_REF_SPP (4096), BENCH_PT_SPP ("1 4 16 64 256"),
-#        BENCH_PT_SCENES ("cornell:128x128 smallpt:128x96"), BENCH_SMALLPT.
+#        BENCH_PT_SCENES ("cornell:128x128 smallpt:128x96"), BENCH_SMALLPT,
+#        BENCH_PT_ROUNDS (BENCH_ROUNDS, else 3).
 set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
@@ -35,6 +41,7 @@ REF_SPP=${BENCH_PT_REF_SPP:-4096}
 SPPS=${BENCH_PT_SPP:-1 4 16 64 256}
 SCENES=${BENCH_PT_SCENES:-cornell:128x128 smallpt:128x96}
 SMALLPT=${BENCH_SMALLPT:-}
+ROUNDS=${BENCH_PT_ROUNDS:-${BENCH_ROUNDS:-3}}
 mkdir -p "$OUT"
 die() { echo "bench/pt.sh: $*" >&2; exit 1; }
 say() { echo "bench: $*" >&2; }
@@ -56,6 +63,18 @@ cpu() {
   cpu=$(awk -v t="$t" 'BEGIN { split(t, a, " "); printf "%.3f", a[1] + a[2] }')
 }
 
+# spread V...: "least median greatest" of the values; range FORMAT V...:
+# "least-greatest"; ratios "A..." "B...": the pairs' ratios (as bench/run.sh).
+spread() {
+  printf '%s\n' "$@" | sort -g |
+    awk '{ v[NR] = $1 } END { if (!NR) exit 1; m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+                              print v[1], m, v[NR] }'
+}
+median() { spread "$@" | awk '{ print $2 }'; }
+range() { local f=$1; shift; spread "$@" | awk -v f="$f" '{ printf f "-" f, $1, $3 }'; }
+ratios() { awk -v a="$1" -v b="$2" 'BEGIN { n = split(a, x, " "); m = split(b, y, " "); if (m < n) n = m
+                                            for (i = 1; i <= n; i++) if (y[i] + 0 > 0) printf "%.6g ", x[i] / y[i] }'; }
+
 # reference NAME SIZE: MIS at $REF_SPP spp, seed 99 (the runs use seed 0:
 # a reference sharing their random numbers would share their noise).
 reference() {
@@ -75,28 +94,40 @@ reference() {
 : >"$OUT/pt.tsv"
 : >"$OUT/pt-targets.txt"
 {
-  echo "Path tracing: time against error, one thread (./ray -t 1 --pt), CPU seconds of the whole run"
+  echo "Path tracing: time against error, one thread (./ray -t 1 --pt); cpu s: CPU seconds (user + system) of the whole"
+  echo "run, the median of $ROUNDS rounds in which the three estimators take turns, and (least-greatest)"
   echo "RMSE: linear radiance against a ${REF_SPP}-spp MIS reference (another seed), every pixel and channel;"
   echo "lit RMSE: the same without the pixels where the reference reaches 1 (the lamp, and its edges, whose"
   echo "noise of covering the pixel is every estimator's); display: 8-bit sRGB levels"
   echo
-  printf '%-8s %-8s %-5s %5s %8s %10s %10s %8s\n' scene size est spp "cpu s" RMSE "lit RMSE" display
+  printf '%-8s %-8s %-5s %5s %8s %-15s %10s %10s %8s\n' scene size est spp "cpu s" "(range)" RMSE "lit RMSE" display
 } | tee "$OUT/pt.txt"
 for item in $SCENES; do
   name=${item%%:*} size=${item#*:}
   [ -f "scenes/$name.sph" ] || die "scenes/$name.sph not found"
   reference "$name" "$size"
-  for est in bsdf nee mis; do
-    for spp in $SPPS; do
+  for spp in $SPPS; do
+    declare -A times=()
+    for ((round = 1; round <= ROUNDS; round++)); do
+      for est in bsdf nee mis; do
+        cpu "$RAY" --pt -t 1 --estimator "$est" -s "$size" -n "$spp" -o "$OUT/pt-$name-$est-$spp.pfm" "scenes/$name.sph" ||
+          die "failed: $name $est $spp"
+        times[$est]+="$cpu "
+      done
+    done
+    for est in bsdf nee mis; do
       img=$OUT/pt-$name-$est-$spp.pfm
-      cpu "$RAY" --pt -t 1 --estimator "$est" -s "$size" -n "$spp" -o "$img" "scenes/$name.sph" ||
-        die "failed: $name $est $spp"
       read -r rmse lit disp <<<"$("$OUT/pfmerr" "$img" "$ref" |
         sed 's/rmse=\([^ ]*\) lit_rmse=\([^ ]*\) display_rmse=\([^ ]*\).*/\1 \2 \3/')"
-      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$size" "$est" "$spp" "$cpu" "$rmse" "$lit" "$disp" >>"$OUT/pt.tsv"
-      printf '%-8s %-8s %-5s %5s %8.3f %10.5f %10.5f %8.2f\n' "$name" "$size" "$est" "$spp" "$cpu" "$rmse" "$lit" "$disp" |
-        tee -a "$OUT/pt.txt"
+      # shellcheck disable=SC2086
+      read -r lo med hi <<<"$(spread ${times[$est]})"
+      # the rounds' times, in order, last (for the ratios round by round)
+      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$size" "$est" "$spp" "$med" "$rmse" "$lit" "$disp" \
+        "$lo" "$hi" "$(printf '%s' "${times[$est]% }" | tr ' ' ,)" >>"$OUT/pt.tsv"
+      printf '%-8s %-8s %-5s %5s %8.3f %-15s %10.5f %10.5f %8.2f\n' "$name" "$size" "$est" "$spp" "$med" \
+        "($(printf '%.3f-%.3f' "$lo" "$hi"))" "$rmse" "$lit" "$disp" | tee -a "$OUT/pt.txt"
     done
+    unset times
   done
 done
 
@@ -112,41 +143,62 @@ slopes=$(awk -F'\t' '$5 >= 0.05 { k = $1 "/" $3; x = log($5); y = log($6);
 awk -F'\t' -v slopes="$slopes" 'BEGIN { n = split(slopes, l, "\n"); for (i = 1; i <= n; i++) { split(l[i], p, " "); s[p[1]] = p[2] } }
   { k = $1 "/" $3; print k ",slope=" s[k], $5, $6, $4 }' "$OUT/pt.tsv" |
   "$OUT/svgplot" --title "make bench: path tracing, time against error (labels: samples per pixel)" \
-    --xlabel "CPU seconds, one thread" --ylabel "RMSE (linear) against the $REF_SPP-spp reference" >"$OUT/pt.svg" ||
+    --xlabel "CPU seconds, one thread (median of the rounds)" --ylabel "RMSE (linear) against the $REF_SPP-spp reference" >"$OUT/pt.svg" ||
   die "svgplot failed"
 
-# Target 1: MIS against BSDF sampling at 256 spp on the Cornell box.
-row() { awk -F'\t' -v n="$1" -v e="$2" -v s="$3" '$1 == n && $3 == e && $4 == s { print $5, $6 }' "$OUT/pt.tsv"; }
-if read -r t_b e_b <<<"$(row cornell bsdf 256)" && [ -n "${e_b:-}" ]; then
-  t_m=$(awk -F'\t' -v e="$e_b" '$1 == "cornell" && $3 == "mis" { t[++n] = $5; r[n] = $6 }
-    END { for (i = 1; i < n; i++) if (r[i] >= e && r[i + 1] <= e) {
-            s = log(r[i + 1] / r[i]) / log(t[i + 1] / t[i]); printf "%.4f", t[i] * exp(log(e / r[i]) / s); exit }
-          if (n && r[1] <= e) printf "<%s", t[1]; else print "" }' "$OUT/pt.tsv")
+# Target 1: MIS against BSDF sampling at 256 spp on the Cornell box, round
+# by round: each round's BSDF time against the time at which that round's
+# MIS runs reach the same RMSE (the RMSEs are the same each round).
+row() { awk -F'\t' -v n="$1" -v e="$2" -v s="$3" '$1 == n && $3 == e && $4 == s { print $5, $6, $11 }' "$OUT/pt.tsv"; }
+if read -r t_b e_b rounds_b <<<"$(row cornell bsdf 256)" && [ -n "${e_b:-}" ]; then
+  # mis_at ROUND: MIS's time at RMSE $e_b in that round (1, 2, ...; 0: the
+  # medians), by log-log interpolation between its two bracketing runs;
+  # "<T" when its cheapest run is already below; empty when never reached.
+  mis_at() {
+    awk -F'\t' -v e="$e_b" -v k="$1" '$1 == "cornell" && $3 == "mis" { split($11, c, ","); t[++n] = k ? c[k] : $5; r[n] = $6 }
+      END { for (i = 1; i < n; i++) if (r[i] >= e && r[i + 1] <= e) {
+              s = log(r[i + 1] / r[i]) / log(t[i + 1] / t[i]); printf "%.4f", t[i] * exp(log(e / r[i]) / s); exit }
+            if (n && r[1] <= e) printf "<%s", t[1]; else print "" }' "$OUT/pt.tsv"
+  }
+  t_m=$(mis_at 0)
   if [ -z "$t_m" ]; then
     echo "Cornell box: MIS never reached BSDF sampling's RMSE at 256 spp ($e_b): NOT MET" >>"$OUT/pt-targets.txt"
   else
-    tm=${t_m#<}
-    x=$(awk "BEGIN { printf \"%.1f\", $t_b / $tm }")
-    v=$(awk "BEGIN { exit !($t_b / $tm >= 10) }" && echo met || echo "NOT MET")
-    echo "Cornell box 128x128, one thread: BSDF sampling at 256 spp: RMSE $e_b in $t_b s CPU; MIS reaches it in ${t_m} s: ${x}x less time (target >= 10x): $v" >>"$OUT/pt-targets.txt"
+    xs=''
+    IFS=, read -r -a tb <<<"$rounds_b"
+    for ((k = 1; k <= ${#tb[@]}; k++)); do
+      tm=$(mis_at "$k")
+      xs+="$(awk -v a="${tb[k - 1]}" -v b="${tm#<}" 'BEGIN { printf "%.4g", a / b }') "
+    done
+    # shellcheck disable=SC2086
+    x=$(printf %.1f "$(median $xs)")
+    v=$(awk "BEGIN { exit !($x >= 10) }" && echo met || echo "NOT MET")
+    # shellcheck disable=SC2086
+    echo "Cornell box $(awk -F'\t' '$1 == "cornell" { print $2; exit }' "$OUT/pt.tsv"), one thread: BSDF sampling at 256 spp: RMSE $e_b in $t_b s CPU; MIS reaches it in ${t_m} s (medians of $ROUNDS rounds taking turns): ${x}x less time ($(range %.1f $xs), the rounds' ratios) (target >= 10x): $v" >>"$OUT/pt-targets.txt"
   fi
 fi
 
 # Target 2: CPU time per sample against smallpt, 1024x768 at 4 spp each,
-# alternated, the best of three of each.
-best_ours= best_sp=
+# taking turns in $ROUNDS rounds.
 if [ -n "$SMALLPT" ] && [ -f "$SMALLPT" ] && command -v g++ >/dev/null && g++ -O3 -w -o "$OUT/smallpt" "$SMALLPT" 2>"$OUT/smallpt-build.log"; then
-  for _ in 1 2 3; do
+  ours='' sp=''
+  for ((round = 1; round <= ROUNDS; round++)); do
     cpu "$RAY" --pt -t 1 --estimator bsdf -s 1024x768 -n 4 -o "$OUT/pt-ours-smallpt.pfm" scenes/smallpt.sph || die "ray failed"
-    best_ours=$(awk -v a="$cpu" -v b="${best_ours:-1e9}" 'BEGIN { print (a < b) ? a : b }')
+    ours+="$cpu "
     cpu bash -c "cd $OUT && OMP_NUM_THREADS=1 exec ./smallpt 4" || die "smallpt failed"
-    best_sp=$(awk -v a="$cpu" -v b="${best_sp:-1e9}" 'BEGIN { print (a < b) ? a : b }')
+    sp+="$cpu "
   done
   samples=$((1024 * 768 * 4))
-  us_o=$(awk "BEGIN { printf \"%.3f\", $best_ours / $samples * 1e6 }")
-  us_s=$(awk "BEGIN { printf \"%.3f\", $best_sp / $samples * 1e6 }")
-  v=$(awk "BEGIN { exit !($us_o <= $us_s) }" && echo met || echo "NOT MET")
-  echo "smallpt's scene 1024x768 at 4 spp, one thread: ours (BSDF sampling) $us_o us of CPU a sample, smallpt (g++ -O3) $us_s us: ratio $(awk "BEGIN { printf \"%.2f\", $us_o / $us_s }") (target <= 1): $v" >>"$OUT/pt-targets.txt"
+  # shellcheck disable=SC2086
+  us_o=$(awk "BEGIN { printf \"%.3f\", $(median $ours) / $samples * 1e6 }")
+  # shellcheck disable=SC2086
+  us_s=$(awk "BEGIN { printf \"%.3f\", $(median $sp) / $samples * 1e6 }")
+  q=$(ratios "$ours" "$sp")
+  # shellcheck disable=SC2086
+  qm=$(printf %.2f "$(median $q)")
+  v=$(awk "BEGIN { exit !($qm <= 1) }" && echo met || echo "NOT MET")
+  # shellcheck disable=SC2086
+  echo "smallpt's scene 1024x768 at 4 spp, one thread, medians of $ROUNDS rounds taking turns: ours (BSDF sampling) $us_o us of CPU a sample, smallpt (g++ -O3) $us_s us: ratio $qm ($(range %.2f $q), the rounds' ratios) (target <= 1): $v" >>"$OUT/pt-targets.txt"
 else
   cpu "$RAY" --pt -t 1 --estimator bsdf -s 1024x768 -n 4 -o "$OUT/pt-ours-smallpt.pfm" scenes/smallpt.sph || die "ray failed"
   us_o=$(awk "BEGIN { printf \"%.3f\", $cpu / (1024 * 768 * 4) * 1e6 }")
@@ -154,21 +206,24 @@ else
 fi
 
 # Target 3: rays per second, path tracing (MIS) against Whitted, smallpt's
-# scene, 256x192 at 16 spp, one thread, the best of three of each.
-mrays() {  # mrays ARGS...: sets $mr, Mrays per CPU second
-  local best=
-  for _ in 1 2 3; do
-    cpu "$RAY" -t 1 --stats -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
-    rays=$(sed -n 's/^rays *\([0-9]*\):.*/\1/p' "$OUT/pt.err" | head -n 1)
-    best=$(awk -v a="$cpu" -v b="${best:-1e9}" 'BEGIN { print (a < b) ? a : b }')
-  done
-  mr=$(awk "BEGIN { printf \"%.2f\", $rays / $best / 1e6 }")
+# scene, 256x192 at 16 spp, one thread: Whitted, MIS and BSDF sampling
+# taking turns in 5 rounds ($ROUNDS if more: these runs are short, about a
+# second, and short runs spread widely on a busy machine).
+mr1() {  # mr1 ARGS...: Mrays per CPU second of one run, to $mr
+  cpu "$RAY" -t 1 --stats -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
+  mr=$(awk -v r="$(sed -n 's/^rays *\([0-9]*\):.*/\1/p' "$OUT/pt.err" | head -n 1)" -v c="$cpu" 'BEGIN { printf "%.4f", r / c / 1e6 }')
 }
-mrays --whitted; mr_w=$mr
-mrays --pt --estimator mis; mr_p=$mr
-mrays --pt --estimator bsdf; mr_b=$mr
-r=$(awk "BEGIN { printf \"%.2f\", $mr_p / $mr_w }")
-v=$(awk "BEGIN { exit !($mr_p >= 0.9 * $mr_w) }" && echo met || echo "NOT MET")
-echo "smallpt's scene 256x192, one thread: path tracing (MIS) $mr_p Mrays/s (BSDF sampling $mr_b), Whitted $mr_w Mrays/s: ratio $r (target >= 0.9): $v" >>"$OUT/pt-targets.txt"
+mr_w='' mr_p='' mr_b='' mr_rounds=$((ROUNDS > 5 ? ROUNDS : 5))
+for ((round = 1; round <= mr_rounds; round++)); do
+  mr1 --whitted; mr_w+="$mr "
+  mr1 --pt --estimator mis; mr_p+="$mr "
+  mr1 --pt --estimator bsdf; mr_b+="$mr "
+done
+q=$(ratios "$mr_p" "$mr_w")
+# shellcheck disable=SC2086
+r=$(printf %.2f "$(median $q)")
+v=$(awk "BEGIN { exit !($r >= 0.9) }" && echo met || echo "NOT MET")
+# shellcheck disable=SC2086
+echo "smallpt's scene 256x192, one thread, medians of $mr_rounds rounds taking turns: path tracing (MIS) $(printf %.2f "$(median $mr_p)") Mrays/s ($(range %.2f $mr_p)) (BSDF sampling $(printf %.2f "$(median $mr_b)")), Whitted $(printf %.2f "$(median $mr_w)") Mrays/s ($(range %.2f $mr_w)): ratio $r ($(range %.2f $q), the rounds' ratios) (target >= 0.9): $v" >>"$OUT/pt-targets.txt"
 
 { echo "Path tracing targets"; sed 's/^/  /' "$OUT/pt-targets.txt"; echo; } | tee -a "$OUT/pt.txt"

@@ -3,8 +3,8 @@
  *     cc -O2 -o raybench bench/raybench.c kdtree.c bvh.c grid.c -lm     (no -fopenmp: one thread)
  *
  *     raybench build [MAXN]          build time against N on cube-spheres of 10k
- *                                    up to MAXN (default 1M) triangles, and the
- *                                    fitted exponent
+ *                                    up to MAXN (default 1M) triangles, for every
+ *                                    structure, and the fitted exponents
  *     raybench rays MESH.obj RAYS.bin...
  *                                    trace the rays of RAYHITS1 files (written by
  *                                    ../shared/embree/embree_rays -out) and compare
@@ -14,6 +14,10 @@
  *                                    the conventions of embree_rays.c's header
  *                                    (bit for bit the same rays), for a machine
  *                                    without Embree: timed, nothing to compare
+ *     raybench accel SCENE W H N | SCENE RAYS.bin...
+ *                                    every structure on the same rays, taking turns
+ *     raybench anim SCENE.nff FRAMES MOVERS [ROUNDS]
+ *                                    rebuild or refit as objects move
  *     raybench far SCENE W H N       kd, bvh and grid with the scene moved to
  *                                    1e4, 1e6 and 1e8 from the origin, and the
  *                                    camera to 1e10 and 1e13 from the scene:
@@ -21,9 +25,14 @@
  *
  * ray.c is included whole, as tests/test_ray.c does, so that what is timed is
  * the renderer's real triangle test, clip callback and tree walk, not a copy
- * that could drift from them.  Everything runs on one thread.  Tables go to
- * standard output, each measurement followed by a line "result key=value ..."
- * for bench/run.sh to read.
+ * that could drift from them.  Everything runs on one thread, and every time
+ * is the thread's CPU time (CLOCK_THREAD_CPUTIME_ID), which leaves out the
+ * time the thread waited while other processes ran: the wall clock of a busy
+ * machine is not a measure of this code.  Whatever is compared takes turns
+ * (the structures in each round, the builds at each size), and each figure
+ * comes with its spread: the best, median and worst of its repeats.  Tables
+ * go to standard output, each measurement followed by a line
+ * "result key=value ..." for bench/run.sh to read.
  */
 #define main ray_main
 #include "../ray.c"
@@ -31,24 +40,35 @@
 #include <stdint.h>
 
 #define RB_PI 3.14159265358979323846
-#define RB_REPEAT 5 /* best of 5: the fastest run is the one least disturbed */
-
-/* A monotonic clock of our own: ray.c's now() is an internal of a file that
- * is being edited, and the bench should not break when it is renamed. */
-static double rb_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
+#define RB_REPEAT 5 /* repeats of each timing: their best, median and worst are printed */
 
 /* The CPU time of this thread, as embree_rays measures it beside the wall
- * clock: on a busy machine it leaves out the time the thread waited. */
+ * clock: on a busy machine it leaves out the time the thread waited.  (Our
+ * own clock rather than ray.c's, an internal of a file being edited.) */
 static double rb_cpu(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
     return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int rb_cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The least, the median and the greatest of n >= 1 values, which are
+ * sorted in place; the median of an even count is the mean of the two in
+ * the middle.  (Of times the least is the best; of rates, the greatest.) */
+typedef struct { double lo, med, hi; } RbSpread;
+static RbSpread rb_spread(double *v, int n)
+{
+    RbSpread s;
+    qsort(v, (size_t)n, sizeof v[0], rb_cmp_double);
+    s.lo = v[0], s.hi = v[n - 1];
+    s.med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    return s;
 }
 
 static void rb_die(const char *what, const char *arg)
@@ -294,12 +314,12 @@ static void rb_load_mesh(Scene *s, const char *path)
     if (s->ntri == 0) rb_die("no triangles in", path);
 }
 
-/* Builds the tree; returns the wall-clock seconds it took. */
+/* Builds the tree; returns the thread's CPU seconds it took. */
 static double rb_build(Scene *s)
 {
-    double t0 = rb_now();
+    double c0 = rb_cpu();
     if (!build_accel(s, "kd") || !s->kd) rb_die("kd-tree build failed", NULL);
-    return rb_now() - t0;
+    return rb_cpu() - c0;
 }
 
 /* What the tree costs in memory and shape, per triangle. */
@@ -307,7 +327,7 @@ static void rb_tree_line(const Scene *s, double seconds)
 {
     kd_info k;
     kd_describe(s->kd, &k);
-    printf("kd-tree    %d objects, built in %.3f s: %ld nodes, depth %ld, %.2f refs/object, "
+    printf("kd-tree    %d objects, built in %.3f s (CPU): %ld nodes, depth %ld, %.2f refs/object, "
            "%.1f bytes/object, SAH cost %.2f\n", nobj(s), seconds, k.nodes, k.max_depth,
            (double)k.prim_refs / nobj(s), (double)k.bytes / nobj(s), k.sah_cost);
     printf("result objects=%d build_s=%.4f nodes=%ld depth=%ld refs_per_obj=%.3f bytes_per_obj=%.2f sah=%.3f\n",
@@ -347,16 +367,14 @@ static void rb_uvn(const Scene *s, int obj, const Query *q, double h[5])
  * material.  bare = 1 returns what rtcIntersect1 returns, no more and no
  * less: the triangle, t, the barycentrics u and v (kept by the tree's hit
  * callback) and the geometric normal unnormalised, e1 x e2; these three go to
- * uvn, five numbers a ray.  Returns the wall-clock seconds, and the
- * thread's CPU seconds in *cpu. */
+ * uvn, five numbers a ray.  Returns the thread's CPU seconds. */
 static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int *obj, double *t,
-                       double *uvn, double *cpu)
+                       double *uvn)
 {
     Worker wk;
-    double t0, c0 = rb_cpu();
+    double c0 = rb_cpu();
     long i;
     memset(&wk, 0, sizeof wk);
-    t0 = rb_now();
     for (i = 0; i < n; i++) {
         Ray r;
         r.o = v3(rays[i].o[0], rays[i].o[1], rays[i].o[2]);
@@ -374,23 +392,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
             else obj[i] = -1, t[i] = INFINITY;
         }
     }
-    *cpu = rb_cpu() - c0;
-    return rb_now() - t0;
-}
-
-/* Best of RB_REPEAT runs, by each clock on its own. */
-static double rb_best(const Scene *s, const RbRay *rays, long n, int bare, int *obj, double *t,
-                      double *uvn, double *cpu)
-{
-    double best = HUGE_VAL;
-    int k;
-    *cpu = HUGE_VAL;
-    for (k = 0; k < RB_REPEAT; k++) {
-        double c, secs = rb_trace(s, rays, n, bare, obj, t, uvn, &c);
-        if (secs < best) best = secs;
-        if (c < *cpu) *cpu = c;
-    }
-    return best;
+    return rb_cpu() - c0;
 }
 
 /* Our hits against Embree's: the same triangle, and t within a relative
@@ -478,23 +480,31 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
 static void rb_rays(Scene *s, const char *set, const RbRay *rays, long n)
 {
     int *obj = malloc((size_t)n * sizeof *obj);
-    double *t = malloc((size_t)n * sizeof *t), full, bare, full_cpu, bare_cpu;
+    double *t = malloc((size_t)n * sizeof *t);
     double *uvn = malloc((size_t)n * 5 * sizeof *uvn);
+    RbSpread full, bare;
     long hits = 0, i;
     if (!obj || !t || !uvn) rb_die("out of memory for hits", NULL);
-    bare = rb_best(s, rays, n, 1, obj, t, uvn, &bare_cpu);
-    full = rb_best(s, rays, n, 0, obj, t, NULL, &full_cpu);   /* last: its hits are compared */
+    /* the two ways take turns, so that both meet the machine's drift alike;
+     * nearest_hit last: its hits are compared */
+    {
+        double f[RB_REPEAT], b[RB_REPEAT];
+        int k;
+        for (k = 0; k < RB_REPEAT; k++) {
+            b[k] = n / rb_trace(s, rays, n, 1, obj, t, uvn) * 1e-6;
+            f[k] = n / rb_trace(s, rays, n, 0, obj, t, NULL) * 1e-6;
+        }
+        full = rb_spread(f, RB_REPEAT), bare = rb_spread(b, RB_REPEAT);
+    }
     for (i = 0; i < n; i++) hits += obj[i] >= 0;
-    printf("rays       %s: %ld rays, %ld hit (%.1f%%), one thread, best of %d\n", set, n, hits,
-           100.0 * hits / n, RB_REPEAT);
-    printf("traversal  nearest_hit %.3f s = %.2f Mrays/s; tree walk alone (kd_nearest, and u, v, Ng as "
-           "rtcIntersect1 gives) %.3f s = %.2f Mrays/s\n",
-           full, n / full * 1e-6, bare, n / bare * 1e-6);
-    printf("           by thread CPU time: nearest_hit %.2f Mrays/s, tree walk alone %.2f Mrays/s\n",
-           n / full_cpu * 1e-6, n / bare_cpu * 1e-6);
-    printf("result set=%s rays=%ld hits=%ld seconds=%.5f mrays=%.3f bare_mrays=%.3f cpu_mrays=%.3f "
-           "cpu_bare_mrays=%.3f\n", set, n, hits, full, n / full * 1e-6, n / bare * 1e-6,
-           n / full_cpu * 1e-6, n / bare_cpu * 1e-6);
+    printf("rays       %s: %ld rays, %ld hit (%.1f%%), one thread, %d runs of each, taking turns\n", set, n,
+           hits, 100.0 * hits / n, RB_REPEAT);
+    printf("traversal  Mrays/s by thread CPU time, median (best - worst): nearest_hit %.2f (%.2f - %.2f); "
+           "tree walk alone (kd_nearest, and u, v, Ng as rtcIntersect1 gives) %.2f (%.2f - %.2f)\n",
+           full.med, full.hi, full.lo, bare.med, bare.hi, bare.lo);
+    printf("result set=%s rays=%ld hits=%ld mrays=%.3f mrays_best=%.3f mrays_worst=%.3f bare_mrays=%.3f "
+           "bare_best=%.3f bare_worst=%.3f\n", set, n, hits, full.med, full.hi, full.lo,
+           bare.med, bare.hi, bare.lo);
     rb_work(s, set, rays, n);
     if (rays[0].prim != -2) rb_compare(s, set, rays, n, obj, t);
     free(obj);
@@ -542,55 +552,6 @@ static void rb_cube_sphere(Scene *s, int k)
                 add_triangle(s, a, d, c, -1, -1, -1, mat);
             }
     }
-}
-
-/* Build time against N, and the exponent p of time ~ N^p by least squares
- * on log time against log N.  Wald and Havran's O(N log N) build gives p a
- * little above 1; p well above means some step grows faster than it should.
- * Short builds are repeated and the fastest kept, as for rays; the 1M build
- * runs once, as one run takes seconds and is hardly disturbed. */
-static void rb_build_table(long maxn)
-{
-    static const long sizes[] = { 10000, 30000, 100000, 300000, 1000000, 3000000 };
-    double sx = 0, sy = 0, sxx = 0, sxy = 0, p;
-    int i, count = 0;
-    printf("Build time against N: cube-spheres, ray.c's triangles and clip callback, one thread\n");
-    printf("%10s %9s %5s %10s %9s %6s %9s %10s %9s\n", "triangles", "build s", "runs", "ns/tri", "nodes",
-           "depth", "refs/tri", "bytes/tri", "SAH cost");
-    for (i = 0; i < (int)(sizeof sizes / sizeof sizes[0]) && sizes[i] <= maxn; i++) {
-        int k = (int)floor(sqrt(sizes[i] / 12.0) + 0.5), runs = 0, n;
-        double best = HUGE_VAL, secs;
-        kd_info info;
-        Scene s;
-        default_scene(&s);
-        rb_cube_sphere(&s, k);
-        n = nobj(&s);
-        do {
-            if (s.kd) kd_free(s.kd), s.kd = NULL;
-            secs = rb_build(&s);
-            if (secs < best) best = secs;
-            runs++;
-        } while (runs < (best < 1 ? RB_REPEAT : best < 3 ? 2 : 1));
-        kd_describe(s.kd, &info);
-        printf("%10d %9.3f %5d %10.0f %9ld %6ld %9.2f %10.1f %9.2f\n", n, best, runs, best / n * 1e9,
-               info.nodes, info.max_depth, (double)info.prim_refs / n, (double)info.bytes / n,
-               info.sah_cost);
-        printf("result triangles=%d build_s=%.4f nodes=%ld depth=%ld refs_per_tri=%.3f bytes_per_tri=%.2f sah=%.3f\n",
-               n, best, info.nodes, info.max_depth, (double)info.prim_refs / n,
-               (double)info.bytes / n, info.sah_cost);
-        sx += log((double)n); sy += log(best);
-        sxx += log((double)n) * log((double)n); sxy += log((double)n) * log(best);
-        count++;
-        rb_free_scene(&s);
-    }
-    if (count < 2) {
-        printf("(one size only: no exponent)\n");
-        return;
-    }
-    p = (count * sxy - sx * sy) / (count * sxx - sx * sx);
-    printf("build time ~ N^%.3f (least squares on log-log, %d sizes)   target: exponent <= 1.15: %s\n",
-           p, count, p <= 1.15 ? "met" : "NOT MET");
-    printf("result exponent=%.4f\n", p);
 }
 
 /* ------------------------------------------------------- every structure */
@@ -717,11 +678,6 @@ static int rb_wanted(int which)
     return 0;
 }
 
-static int rb_cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* Every structure on one set of rays, in ROUNDS rounds, each round tracing
  * with every structure in turn, so that all meet the machine's drift
@@ -793,53 +749,100 @@ static void rb_free_all(RbAll *A)
     kd_free(A->kd), bvh_free(A->sah), bvh_free(A->median), grid_free(A->g);
 }
 
-/* The same for the BVH (both builds) and the grid: CPU seconds of each build,
- * best of several, and the exponent of each against N. */
-static void rb_build_others(long maxn)
+/* Build time against N for every structure, and the exponent p of
+ * time ~ N^p by least squares on log time against log N.  Wald and
+ * Havran's O(N log N) build gives p a little above 1; p well above means
+ * some step grows faster than it should.  At each size the four builds take
+ * turns (kd, BVH SAH, BVH median, grid; each freed once timed, so that one
+ * build's memory is about at a time), 5 rounds, 3 once a kd build takes
+ * over a second; the median of each is the figure, and p is fitted to the
+ * medians (and, for comparison, to the best runs). */
+static void rb_build_table(long maxn)
 {
     static const long sizes[] = { 10000, 30000, 100000, 300000, 1000000, 3000000 };
-    static const int which[3] = { RB_BVH, RB_BVH_MEDIAN, RB_GRID };
-    double sx = 0, sxx = 0, sy[3] = {0}, sxy[3] = {0};
-    int i, j, count = 0;
-    printf("Build time against N, the other structures (the same cube-spheres; CPU seconds, best of 5, of 2 "
-           "past a second)\n%10s", "triangles");
-    for (j = 0; j < 3; j++) printf(" %11s s %7s", rb_names[which[j]], "ns/tri");
-    printf("\n");
-    for (i = 0; i < (int)(sizeof sizes / sizeof sizes[0]) && sizes[i] <= maxn; i++) {
-        int k = (int)floor(sqrt(sizes[i] / 12.0) + 0.5), n, r;
+    static const int which[4] = { RB_KD, RB_BVH, RB_BVH_MEDIAN, RB_GRID };
+    enum { NS = sizeof sizes / sizeof sizes[0] };
+    RbSpread sp[NS][4];
+    kd_info info[NS];
+    int nobjs[NS], rounds[NS], i, j, count = 0;
+    double sx = 0, sxx = 0, sy[4] = { 0 }, sxy[4] = { 0 }, syb[4] = { 0 }, sxyb[4] = { 0 };
+    for (i = 0; i < NS && sizes[i] <= maxn; i++) {
+        int k = (int)floor(sqrt(sizes[i] / 12.0) + 0.5), r;
+        double c[4][RB_REPEAT];
         Scene s;
         RbAll A;
         default_scene(&s);
         rb_cube_sphere(&s, k);
-        build_accel(&s, "none");
+        if (!build_accel(&s, "none")) rb_die("cannot set up the callbacks", NULL);
         memset(&A, 0, sizeof A);
         A.s = &s;
-        n = nobj(&s);
-        printf("%10d", n);
-        for (j = 0; j < 3; j++) {
-            double best = HUGE_VAL;
-            for (r = 0; r < 5 && (r < 2 || best < 1); r++) {
-                double c = rb_cpu_build(&A, which[j]);
-                if (c < best) best = c;
+        nobjs[i] = nobj(&s);
+        rounds[i] = RB_REPEAT;
+        for (r = 0; r < rounds[i]; r++) {
+            for (j = 0; j < 4; j++) {
+                c[j][r] = rb_cpu_build(&A, which[j]);
+                if (which[j] == RB_KD) {
+                    if (!A.kd) rb_die("kd-tree build failed", NULL);
+                    if (r == 0) kd_describe(A.kd, &info[i]);
+                    kd_free(A.kd), A.kd = NULL;
+                } else if (which[j] == RB_GRID) grid_free(A.g), A.g = NULL;
+                else if (which[j] == RB_BVH) bvh_free(A.sah), A.sah = NULL;
+                else bvh_free(A.median), A.median = NULL;
             }
-            printf(" %13.4f %7.0f", best, best / n * 1e9);
-            sy[j] += log(best), sxy[j] += log((double)n) * log(best);
-            A.build[which[j]] = best;
+            if (r == 0 && c[0][0] > 1) rounds[i] = 3;
         }
-        printf("\n");
-        for (j = 0; j < 3; j++)
-            printf("result structure=%s triangles=%d build_s=%.5f\n", rb_names[which[j]], n,
-                   A.build[which[j]]);
-        sx += log((double)n), sxx += log((double)n) * log((double)n);
+        for (j = 0; j < 4; j++) {
+            sp[i][j] = rb_spread(c[j], rounds[i]);
+            sy[j] += log(sp[i][j].med), sxy[j] += log((double)nobjs[i]) * log(sp[i][j].med);
+            syb[j] += log(sp[i][j].lo), sxyb[j] += log((double)nobjs[i]) * log(sp[i][j].lo);
+        }
+        sx += log((double)nobjs[i]), sxx += log((double)nobjs[i]) * log((double)nobjs[i]);
         count++;
-        bvh_free(A.sah), bvh_free(A.median), grid_free(A.g);
         rb_free_scene(&s);
     }
-    if (count < 2) return;
-    printf("build time ~ N^p:");
-    for (j = 0; j < 3; j++) {
-        double p = (count * sxy[j] - sx * sy[j]) / (count * sxx - sx * sx);
-        printf(" %s %.3f%s", rb_names[which[j]], p, j < 2 ? "," : "\n");
+    printf("Build time against N: cube-spheres, ray.c's triangles and clip callback, one thread, CPU seconds;\n"
+           "at each size the four structures' builds take turns, 5 rounds (3 past a second): median (best - worst)\n");
+    printf("%10s %9s %19s %5s %8s %9s %6s %9s %10s %9s\n", "triangles", "kd s", "(best - worst)", "runs",
+           "ns/tri", "nodes", "depth", "refs/tri", "bytes/tri", "SAH cost");
+    for (i = 0; i < count; i++) {
+        int n = nobjs[i];
+        const RbSpread *k = &sp[i][0];
+        printf("%10d %9.4f  (%7.4f - %7.4f) %5d %8.0f %9ld %6ld %9.2f %10.1f %9.2f\n", n, k->med, k->lo, k->hi,
+               rounds[i], k->med / n * 1e9, info[i].nodes, info[i].max_depth,
+               (double)info[i].prim_refs / n, (double)info[i].bytes / n, info[i].sah_cost);
+        printf("result triangles=%d build_s=%.5f build_best=%.5f build_worst=%.5f nodes=%ld depth=%ld "
+               "refs_per_tri=%.3f bytes_per_tri=%.2f sah=%.3f\n", n, k->med, k->lo, k->hi, info[i].nodes,
+               info[i].max_depth, (double)info[i].prim_refs / n, (double)info[i].bytes / n, info[i].sah_cost);
+    }
+    printf("\nThe other structures, the same builds (CPU seconds, median (best - worst), and ns a triangle)\n%10s",
+           "triangles");
+    for (j = 1; j < 4; j++) printf(" %10s s %19s %6s", rb_names[which[j]], "(best - worst)", "ns/tri");
+    printf("\n");
+    for (i = 0; i < count; i++) {
+        printf("%10d", nobjs[i]);
+        for (j = 1; j < 4; j++)
+            printf(" %12.4f  (%7.4f - %7.4f) %6.0f", sp[i][j].med, sp[i][j].lo, sp[i][j].hi,
+                   sp[i][j].med / nobjs[i] * 1e9);
+        printf("\n");
+        for (j = 1; j < 4; j++)
+            printf("result structure=%s triangles=%d build_s=%.5f build_best=%.5f build_worst=%.5f\n",
+                   rb_names[which[j]], nobjs[i], sp[i][j].med, sp[i][j].lo, sp[i][j].hi);
+    }
+    if (count < 2) {
+        printf("(one size only: no exponent)\n");
+        return;
+    }
+    {
+        double d = count * sxx - sx * sx, p[4], pb[4];
+        for (j = 0; j < 4; j++)
+            p[j] = (count * sxy[j] - sx * sy[j]) / d, pb[j] = (count * sxyb[j] - sx * syb[j]) / d;
+        printf("build time ~ N^p, least squares on log-log over %d sizes, fitted to the medians (to the best runs):\n ",
+               count);
+        for (j = 0; j < 4; j++) printf(" %s %.3f (%.3f)%s", rb_names[which[j]], p[j], pb[j], j < 3 ? "," : "\n");
+        printf("kd-tree: build time ~ N^%.3f   target: exponent <= 1.15: %s\n", p[0], p[0] <= 1.15 ? "met" : "NOT MET");
+        printf("result exponent=%.4f exponent_best=%.4f\n", p[0], pb[0]);
+        for (j = 1; j < 4; j++)
+            printf("result structure=%s exponent=%.4f exponent_best=%.4f\n", rb_names[which[j]], p[j], pb[j]);
     }
 }
 
@@ -864,8 +867,11 @@ static long rb_count(const char *arg, long max)
  * strategies get the structure up to date and trace 256x256 primary rays
  * from the scene's camera: rebuild the kd-tree, rebuild the BVH, refit the
  * BVH built at frame 0, rebuild the grid.  Per strategy: CPU seconds to
- * build (or refit) and to trace, summed over the frames, and the refitted
- * BVH's trace time against the rebuilt one's as the frames go by. */
+ * build (or refit) and to trace, a frame's mean, and the refitted BVH's
+ * trace time against the rebuilt one's as the frames go by.  The whole
+ * animation runs ROUNDS times (3 unless given), each from nothing; each
+ * figure is the median of the rounds, printed with the least and the
+ * greatest. */
 typedef struct {
     vec *from;        /* each moving sphere's place at frame 0 */
     int first, count; /* the moving spheres */
@@ -920,15 +926,18 @@ static double rb_frame(Scene *s, int strategy, const RbRay *rays, long n, double
     return rb_trace_cpu(s, rays, n);
 }
 
-static void rb_anim(const char *path, int frames, int movers)
+#define RB_ANIM_ROUNDS_MAX 9
+static void rb_anim(const char *path, int frames, int movers, int rounds)
 {
     static const char *const names[4] = { "rebuild kd", "rebuild BVH", "refit BVH", "rebuild grid" };
     Scene s[4];
     RbMotion m;
     RbRay *rays;
-    double eye[3], at[3], up[3], fov, build[4] = {0}, trace[4] = {0}, lo[3], hi[3];
-    double first_ratio = 0, last_ratio = 0, mid_ratio = 0;
-    int k, f, a, w = 256;
+    double eye[3], at[3], up[3], fov, lo[3], hi[3];
+    double bms[4][RB_ANIM_ROUNDS_MAX], tms[4][RB_ANIM_ROUNDS_MAX], all[4][RB_ANIM_ROUNDS_MAX];
+    double ratio[3][RB_ANIM_ROUNDS_MAX];
+    RbSpread bs[4], ts[4], as[4], rs[3];
+    int k, f, a, w = 256, round;
     if (!rb_nff_view(path, eye, at, up, &fov)) rb_die("no view in", path);
     for (k = 0; k < 4; k++) {
         default_scene(&s[k]);
@@ -966,39 +975,56 @@ static void rb_anim(const char *path, int frames, int movers)
     for (k = 0; k < m.count; k++) m.from[k] = s[0].sph[m.first + k].cen;
     for (k = 0; k < 4; k++) build_accel(&s[k], "none");
     rays = rb_primary(&s[0], w, w, path);
-    printf("animation %s: %d objects, %s, %d frames, %dx%d primary rays a frame, one thread, CPU time\n",
+    printf("animation %s: %d objects, %s, %d frames, %dx%d primary rays a frame, one thread, CPU time;\n"
+           "%d rounds of every frame, the four strategies taking turns at each frame\n",
            path, nobj(&s[0]), m.twist ? "every sphere twisted about the up axis" : "balls falling through",
-           frames, w, w);
+           frames, w, w, rounds);
     printf("%6s", "frame");
     for (k = 0; k < 4; k++) printf("  %-12s build/trace ms", names[k]);
-    printf("\n");
-    for (f = 0; f < frames; f++) {
-        double b[4], t[4];
-        for (k = 0; k < 4; k++) {
-            rb_move(&s[k], &m, (double)f / (frames > 1 ? frames - 1 : 1));
-            t[k] = rb_frame(&s[k], k, rays, (long)w * w, &b[k]);
-            build[k] += b[k], trace[k] += t[k];
+    printf("   (the first round)\n");
+    for (round = 0; round < rounds; round++) {
+        double build[4] = { 0 }, trace[4] = { 0 };
+        for (k = 0; k < 4; k++) {   /* each round starts from nothing: frame 0 builds */
+            if (s[k].kd) kd_free(s[k].kd), s[k].kd = NULL;
+            if (s[k].bvh) bvh_free(s[k].bvh), s[k].bvh = NULL;
+            if (s[k].grid) grid_free(s[k].grid), s[k].grid = NULL;
         }
-        if (f == 0) first_ratio = t[2] / t[1];
-        if (f == frames / 2) mid_ratio = t[2] / t[1];
-        last_ratio = t[2] / t[1];
-        if (f % 10 == 0 || f == frames - 1) {
-            printf("%6d", f);
-            for (k = 0; k < 4; k++) printf("  %8.2f / %7.2f            ", b[k] * 1e3, t[k] * 1e3);
-            printf("\n");
+        for (f = 0; f < frames; f++) {
+            double b[4], t[4];
+            for (k = 0; k < 4; k++) {
+                rb_move(&s[k], &m, (double)f / (frames > 1 ? frames - 1 : 1));
+                t[k] = rb_frame(&s[k], k, rays, (long)w * w, &b[k]);
+                build[k] += b[k], trace[k] += t[k];
+            }
+            if (f == 0) ratio[0][round] = t[2] / t[1];
+            if (f == frames / 2) ratio[1][round] = t[2] / t[1];
+            ratio[2][round] = t[2] / t[1];
+            if (round == 0 && (f % 10 == 0 || f == frames - 1)) {
+                printf("%6d", f);
+                for (k = 0; k < 4; k++) printf("  %8.2f / %7.2f            ", b[k] * 1e3, t[k] * 1e3);
+                printf("\n");
+            }
+        }
+        for (k = 0; k < 4; k++) {
+            bms[k][round] = build[k] / frames * 1e3, tms[k][round] = trace[k] / frames * 1e3;
+            all[k][round] = bms[k][round] + tms[k][round];
         }
     }
-    printf("per frame, mean:");
     for (k = 0; k < 4; k++)
-        printf("  %s %.2f + %.2f = %.2f ms", names[k], build[k] / frames * 1e3, trace[k] / frames * 1e3,
-               (build[k] + trace[k]) / frames * 1e3);
-    printf("\nrefitted BVH's trace time over a rebuilt one's: frame 0 %.2f, frame %d %.2f, frame %d %.2f\n",
-           first_ratio, frames / 2, mid_ratio, frames - 1, last_ratio);
+        bs[k] = rb_spread(bms[k], rounds), ts[k] = rb_spread(tms[k], rounds), as[k] = rb_spread(all[k], rounds);
+    for (k = 0; k < 3; k++) rs[k] = rb_spread(ratio[k], rounds);
+    printf("per frame, mean over the frames, ms: the median of the %d rounds (least - greatest)\n", rounds);
     for (k = 0; k < 4; k++)
-        printf("result anim=%s strategy=%d build_ms=%.3f trace_ms=%.3f\n", m.twist ? "twist" : "fall", k,
-               build[k] / frames * 1e3, trace[k] / frames * 1e3);
+        printf("  %-12s build %8.2f (%.2f - %.2f) + trace %7.2f (%.2f - %.2f) = %8.2f (%.2f - %.2f)\n", names[k],
+               bs[k].med, bs[k].lo, bs[k].hi, ts[k].med, ts[k].lo, ts[k].hi, as[k].med, as[k].lo, as[k].hi);
+    printf("refitted BVH's trace time over a rebuilt one's (median of the rounds): frame 0 %.2f, frame %d %.2f, "
+           "frame %d %.2f\n", rs[0].med, frames / 2, rs[1].med, frames - 1, rs[2].med);
+    for (k = 0; k < 4; k++)
+        printf("result anim=%s strategy=%d build_ms=%.3f build_lo=%.3f build_hi=%.3f trace_ms=%.3f trace_lo=%.3f "
+               "trace_hi=%.3f total_ms=%.3f total_lo=%.3f total_hi=%.3f\n", m.twist ? "twist" : "fall", k,
+               bs[k].med, bs[k].lo, bs[k].hi, ts[k].med, ts[k].lo, ts[k].hi, as[k].med, as[k].lo, as[k].hi);
     printf("result anim=%s refit_ratio_first=%.3f refit_ratio_mid=%.3f refit_ratio_last=%.3f\n",
-           m.twist ? "twist" : "fall", first_ratio, mid_ratio, last_ratio);
+           m.twist ? "twist" : "fall", rs[0].med, rs[1].med, rs[2].med);
     free(rays), free(m.from);
     for (k = 0; k < 4; k++) rb_free_scene(&s[k]);
 }
@@ -1298,7 +1324,8 @@ static void rb_usage(void)
           "       raybench accel SCENE W H N [VIEW.nff]   (every structure on W x H primary and N\n"
           "                                                random rays; SCENE .obj or .nff)\n"
           "       raybench accel SCENE RAYS.bin...        (every structure on RAYHITS1 rays)\n"
-          "       raybench anim SCENE.nff FRAMES MOVERS   (rebuild or refit as objects move)\n"
+          "       raybench anim SCENE.nff FRAMES MOVERS [ROUNDS]\n"
+          "                                               (rebuild or refit as objects move; 3 rounds)\n"
           "       raybench far SCENE W H N                (kd, bvh, grid with the scene moved to 1e4, 1e6,\n"
           "                                                1e8 and the camera to 1e10, 1e13)\n", stderr);
     exit(2);
@@ -1310,11 +1337,11 @@ int main(int argc, char **argv)
     if (argc < 2) rb_usage();
     if (!strcmp(argv[1], "build") && argc <= 3) {
         rb_build_table(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
-        rb_build_others(argc == 3 ? rb_count(argv[2], 100000000) : 1000000);
         return 0;
     }
-    if (!strcmp(argv[1], "anim") && argc == 5) {
-        rb_anim(argv[2], (int)rb_count(argv[3], 100000), (int)strtol(argv[4], NULL, 10));
+    if (!strcmp(argv[1], "anim") && (argc == 5 || argc == 6)) {
+        rb_anim(argv[2], (int)rb_count(argv[3], 100000), (int)strtol(argv[4], NULL, 10),
+                argc == 6 ? (int)rb_count(argv[5], RB_ANIM_ROUNDS_MAX) : 3);
         return 0;
     }
     if (!strcmp(argv[1], "far") && argc == 6) {

@@ -26,7 +26,7 @@ export ACCEL_RAYS=${ACCEL_RAYS:-250000}
 
 # Two runs at a time, one per core; the lines are printed in a fixed order.
 structures="kd bvh-sah bvh-median grid"
-scenes="same mesh grid thirds soup flat empty one"
+scenes="same mesh grid thirds tenths soup flat empty one"
 for a in $structures; do
   for s in $scenes; do
     ( "$TMP/test_accel" "$a" "$s" >"$TMP/$a.$s.out" 2>"$TMP/$a.$s.err"; echo $? >"$TMP/$a.$s.rc" ) &

@@ -15,12 +15,12 @@ count() { while read -r line; do echo "$line"; case $line in PASS*) pass=$((pass
 $CC $CFLAGS -o "$TMP/test_accel" tests/test_accel.c kdtree.c bvh.c grid.c -lm || exit 2
 mkdir -p "$TMP/acc"
 for a in kd bvh-sah bvh-median grid; do
-  for s in same mesh grid thirds soup flat empty one; do     # two at a time, one per core
+  for s in same mesh grid thirds tenths soup flat empty one; do     # two at a time, one per core
     ACCEL_RAYS=1000000 "$TMP/test_accel" $a "$s" > "$TMP/acc/0.$a.$s" 2>/dev/null &
     [ "$(jobs -r | wc -l)" -ge 2 ] && wait -n
   done
   for seed in 11 12; do
-    for s in same mesh grid thirds soup flat; do
+    for s in same mesh grid thirds tenths soup flat; do
       ACCEL_RAYS=500000 ACCEL_SCALE=4 ACCEL_SEED=$seed "$TMP/test_accel" $a "$s" > "$TMP/acc/$seed.$a.$s" 2>/dev/null &
       [ "$(jobs -r | wc -l)" -ge 2 ] && wait -n
     done

@@ -3,7 +3,7 @@
  *     test_accel STRUCTURE SCENE [RAYS]
  *
  * STRUCTURE is kd (kdtree.c), bvh-sah or bvh-median (bvh.c, its two builds)
- * or grid (grid.c); SCENE is one of: soup mesh grid thirds same flat empty
+ * or grid (grid.c); SCENE is one of: soup mesh grid thirds tenths same flat empty
  * one.  Prints one line per check, "PASS ..." or "FAIL ...", and exits 1 if
  * any check failed.  RAYS (default 1000000, or $ACCEL_RAYS) rays are shot per
  * scene; each must give the same primitive and bitwise the same t as the loop
@@ -277,8 +277,8 @@ static int clip(void *user, int i, const double blo[3], const double bhi[3],
     tol = 1e-12 * (fabs(tlo[0]) + fabs(tlo[1]) + fabs(tlo[2]) + fabs(thi[0])
                    + fabs(thi[1]) + fabs(thi[2]));
     for (a = 0; a < 3 && n > 0; a++) {
-        n = cut(poly[cur], n, poly[1 - cur], a, blo[a] - tol, 1), cur = 1 - cur;
-        if (n > 0) n = cut(poly[cur], n, poly[1 - cur], a, bhi[a] + tol, -1), cur = 1 - cur;
+        n = cut(poly[cur], n, poly[1 - cur], a, blo[a], 1), cur = 1 - cur;
+        if (n > 0) n = cut(poly[cur], n, poly[1 - cur], a, bhi[a], -1), cur = 1 - cur;
     }
     if (n == 0) return 0;
     for (a = 0; a < 3; a++) {
@@ -367,8 +367,12 @@ static void make_mesh(scene *s)
  * two triangles each, some of them repeated: splits fall on lattice planes,
  * rays along lattice lines run along edges and through corners.  With step
  * 1 every coordinate is a float; with step 1/3 ("thirds") most are not, and
- * the tree's float planes and boxes round them (see kd_box in kdtree.c; the BVH rounds its boxes outwards). */
-static void make_grid(scene *s, double step)
+ * the tree's float planes and boxes round them (see kd_box in kdtree.c; the BVH rounds its boxes outwards).
+ * "tenths" puts the lattice at -0.2 with step 0.1, and rectangles in the
+ * planes 0..7 (not 0..6), so some lie on the box's far sides: there a cell's
+ * face computed as lo + i w rounds short of the box (-0.2 + 8 (0.7 / 8) <
+ * 0.5), and the grid once lost the rectangles lying on that side. */
+static void make_grid(scene *s, double step, double at)
 {
     int q, nq = (int)(120 * scale), k = 0;
     s->p = alloc_prims(2 * nq);
@@ -382,12 +386,12 @@ static void make_grid(scene *s, double step)
             k += 2;
             continue;
         }
-        c = irand(7);
-        v[0][ax] = v[1][ax] = v[2][ax] = v[3][ax] = c * step;
-        v[0][u] = u0 * step, v[0][w] = w0 * step;
-        v[1][u] = (u0 + du) * step, v[1][w] = w0 * step;
-        v[2][u] = (u0 + du) * step, v[2][w] = (w0 + dw) * step;
-        v[3][u] = u0 * step, v[3][w] = (w0 + dw) * step;
+        c = irand(at != 0 ? 8 : 7);
+        v[0][ax] = v[1][ax] = v[2][ax] = v[3][ax] = at + c * step;
+        v[0][u] = at + u0 * step, v[0][w] = at + w0 * step;
+        v[1][u] = at + (u0 + du) * step, v[1][w] = at + w0 * step;
+        v[2][u] = at + (u0 + du) * step, v[2][w] = at + (w0 + dw) * step;
+        v[3][u] = at + u0 * step, v[3][w] = at + (w0 + dw) * step;
         s->p[k++] = make_tri(v[0], v[1], v[2]);
         s->p[k++] = make_tri(v[0], v[2], v[3]);
     }
@@ -435,8 +439,9 @@ static int make_scene(const char *name, scene *s)
     s->name = name;
     if (!strcmp(name, "soup")) make_soup(s);
     else if (!strcmp(name, "mesh")) make_mesh(s);
-    else if (!strcmp(name, "grid")) make_grid(s, 1);
-    else if (!strcmp(name, "thirds")) make_grid(s, 1.0 / 3);
+    else if (!strcmp(name, "grid")) make_grid(s, 1, 0);
+    else if (!strcmp(name, "thirds")) make_grid(s, 1.0 / 3, 0);
+    else if (!strcmp(name, "tenths")) make_grid(s, 0.1, -0.2);
     else if (!strcmp(name, "same")) make_same(s);
     else if (!strcmp(name, "flat")) make_flat(s);
     else if (!strcmp(name, "one")) make_one(s);
@@ -1175,7 +1180,7 @@ int main(int argc, char **argv)
         if (!strcmp(argv[1], accel_names[k])) acc.name = accel_names[k], acc.kind = k, A = &acc;
     if (!A || argc < 3 || !make_scene(argv[2], &s)) {
         fprintf(stderr, "usage: test_accel kd|bvh-sah|bvh-median|grid "
-                "soup|mesh|grid|thirds|same|flat|empty|one [rays]\n");
+                "soup|mesh|grid|thirds|tenths|same|flat|empty|one [rays]\n");
         return 2;
     }
     p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s, p.eps = 0;
