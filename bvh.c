@@ -59,34 +59,41 @@
 #define STACK_SIZE 96
 
 /* The frame.  Boxes are floats relative to a centre c near the middle of
- * the scene box (see frame), not to the origin, so that a float step is
+ * the scene box (prims_frame, prims.h), not to the origin, so that a float step is
  * 2^-23 of the scene's size wherever the scene lies; they are rounded
  * outwards, so each holds its primitives' double boxes whole (give or take
  * the rounding of x - c in double, 2^-53 ext).
  *
  * The margin.  The walk treats every box as grown on every side by
- *     delta = BVH_EPS * ext + ulps * m,
- * ext the largest |coordinate| of the scene box in the frame, m the largest
- * |coordinate| of the scene box and of the ray origin in the caller's.
- * The hit callback's point may lie outside its primitive's box by
- * PRIMS_HIT_REL of the box's longest side (at most 2 ext) plus
- * PRIMS_HIT_ULPS eps m (the contract of prims.h).  The slab test runs in
- * float in the frame, from an origin within 2 ext of the frame's centre
- * (setup_ray moves a farther one along the ray to where it enters the
- * grown scene box): b - o rounds by 2^-24 of |b - o| <= 3 ext, d to float,
- * 1/d and the product by 2^-24 each, so a computed crossing may be off by
- * 4 * 2^-24 * 3 ext = 7.2e-7 ext in space.  With the callback's
- * 2 * 2^-24 ext, 8.3e-7 ext; BVH_EPS = 2^-20 = 9.5e-7 covers them.  The
- * origin shifted by delta is rounded away from the box (see setup_ray), so
- * its own rounding only adds margin.  The origin moved along the ray,
- * o - c + t0 d, is summed exactly and rounded once (see moved), so it
- * lies on the ray to within a rounding of a number of the scene's size;
- * the walk's t is then the caller's t less t0, and the best hit's t is
- * taken there in double (exact when t0 is more than half of it) before it
- * is rounded up to a float.  So the one part of size m is the callback's,
- * and ulps = PRIMS_HIT_ULPS eps.  The float test is valid while the
- * numbers stay well inside the float range (FAST_MAX below); other rays
- * are answered by testing every primitive. */
+ *     delta = BVH_EPS * ext + ulps * s,
+ * ext the largest |coordinate| of the scene box in the frame, s the largest
+ * in the caller's.  The hit callback's point may lie outside its
+ * primitive's box by PRIMS_HIT_REL of the box's longest side (at most
+ * 2 ext) plus PRIMS_HIT_ULPS eps s (the contract of prims.h; ulps is
+ * PRIMS_HIT_ULPS eps).  The slab test runs in float in the frame, from an
+ * origin within 2 ext of the frame's centre (setup_ray moves a farther one
+ * along the ray to where it enters the grown scene box): b - o rounds by
+ * 2^-24 of |b - o| <= 3 ext, d to float, 1/d and the product by 2^-24
+ * each, so a computed crossing may be off by 4 * 2^-24 * 3 ext =
+ * 7.2e-7 ext in space.  With the callback's 2 * 2^-24 ext, 8.3e-7 ext;
+ * BVH_EPS = 2^-20 = 9.5e-7 covers them.  The origin shifted by delta is
+ * rounded away from the box (see setup_ray), so its own rounding only adds
+ * margin.  The origin moved along the ray, o - c + t0 d, is summed exactly
+ * and rounded once (prims_along, prims.h), so it lies on the ray to within
+ * a rounding of a number of the scene's size; the walk's t is then the caller's t
+ * less t0, taken in double (exact when t0 is more than half of it) before
+ * it is rounded up to a float.
+ *
+ * The slack.  The contract also lets the callback's t err along the ray by
+ * ulps m / max|d|, m the larger of s and the origin's largest |coordinate|
+ * (a ray from 10^13 away has t of 10^13, rounded by 10^-3): the walk takes
+ * the ray from tmin - slack, and leaves a box out only when the ray enters
+ * it more than slack beyond the best hit so far.  So a far origin costs a
+ * box now and then just behind the hit, not a margin across every box.
+ *
+ * The float test is valid while the numbers stay well inside the float
+ * range (FAST_MAX below); other rays are answered by testing every
+ * primitive. */
 #define BVH_EPS (1.0 / 1048576.0)
 #define FAST_MAX 0x1p60
 #define FAST_MIN 0x1p-60
@@ -132,7 +139,8 @@ struct bvh {
     double lo[3], hi[3];  /* the root's boxes together, in the frame */
     double ext;        /* largest |coordinate| of the root's boxes in the frame */
     double scale;      /* largest |coordinate| of the root's boxes in the caller's coordinates */
-    double ulps;       /* the margin's factor of m: PRIMS_HIT_ULPS eps (see BVH_EPS) */
+    double ulps;       /* PRIMS_HIT_ULPS eps (see BVH_EPS) */
+    double delta;      /* the margin (see BVH_EPS) */
     bvh_info info;
 };
 
@@ -169,7 +177,8 @@ typedef struct {
     float on[3], of[3], inv[3];
     int neg[3];
     float tmin;
-    double toff;
+    double toff;       /* how far along the ray the origin was moved */
+    double slack;      /* how far along the ray a hit's t may err (see BVH_EPS) */
     int skip;
 } bvh_ray;
 
@@ -179,20 +188,6 @@ typedef struct {
     uint32_t index, count;
     float entry;
 } bvh_todo;
-
-/* o - c + t d, each step exact and the sum rounded once: Knuth's TwoSum
- * for the sums, and for the product Dekker's split by a fused multiply-add
- * (the exact product's rounding error is fma(t, d, -t d)).  Rounded step
- * by step, an origin 1e13 away would land off the ray by 1e-3; this way
- * it lands within a rounding of where it lands, a number of the scene's
- * size.  (kdtree.c's moved is the same.) */
-static double moved(double o, double c, double t, double d)
-{
-    double s = o - c, z = s - o, e = (o - (s - z)) + (-c - z);         /* s + e = o - c */
-    double p = t * d, pe = fma(t, d, -p);                              /* p + pe = t d */
-    double s2 = s + p, z2 = s2 - s, e2 = (s - (s2 - z2)) + (p - z2);   /* s2 + e2 = s + p */
-    return s2 + (e + e2 + pe);
-}
 
 /* The ray set up for the float slab test: 1, or 0 when its numbers leave
  * the test's range (see BVH_EPS), or -1 when it can hit nothing: NaN or
@@ -205,7 +200,7 @@ static double moved(double o, double c, double t, double d)
 static int setup_ray(const bvh *t, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, bvh_ray *r)
 {
-    double scale = t->scale, dmax = 0, delta, o[3], far = 0;
+    double scale = t->scale, dmax = 0, delta = t->delta, o[3], far = 0;
     int a;
     for (a = 0; a < 3; a++) {
         double m = fabs(org[a]), d = fabs(dir[a]);
@@ -218,12 +213,14 @@ static int setup_ray(const bvh *t, const double org[3], const double dir[3],
     r->skip = skip;
     if (!(scale <= FAST_MAX && scale >= FAST_MIN && dmax <= FAST_MAX && dmax >= FAST_MIN))
         return 0;
-    delta = BVH_EPS * t->ext + t->ulps * scale;
+    r->slack = t->ulps * scale / dmax;
     r->toff = 0;
+    tmin -= r->slack;
     if (far > 2 * t->ext) {
-        double t0 = tmin, t1 = tmax;
+        double t0 = tmin, t1 = tmax + r->slack;
+        double grow = delta + t->ulps * scale;   /* o is rounded by a few eps m */
         for (a = 0; a < 3; a++) {
-            double lo = t->lo[a] - delta - o[a], hi = t->hi[a] + delta - o[a], inv, ta, tb;
+            double lo = t->lo[a] - grow - o[a], hi = t->hi[a] + grow - o[a], inv, ta, tb;
             if (dir[a] == 0) {
                 if (!(lo <= 0 && hi >= 0)) return -1;
                 continue;
@@ -236,7 +233,7 @@ static int setup_ray(const bvh *t, const double org[3], const double dir[3],
         }
         if (!(t0 <= t1)) return -1;
         r->toff = t0;
-        for (a = 0; a < 3; a++) o[a] = moved(org[a], t->c[a], t0, dir[a]);
+        for (a = 0; a < 3; a++) o[a] = prims_along(org[a], t->c[a], t0, dir[a]);
     }
     for (a = 0; a < 3; a++) {
         int neg = signbit(dir[a]) != 0;
@@ -249,10 +246,11 @@ static int setup_ray(const bvh *t, const double org[3], const double dir[3],
     return 1;
 }
 
-/* The caller's t as the walk's float t, rounded up. */
+/* The latest t of the walk's (see setup_ray), rounded up to a float, at
+ * which the point of a hit at the caller's t may lie. */
 static float walk_t(const bvh_ray *r, double t)
 {
-    return up(t - r->toff);
+    return up(t - r->toff + r->slack);
 }
 
 /* Intersect(ray, object) for each primitive of a leaf.  Nearest: keep the
@@ -477,39 +475,6 @@ static int prim_box(const prims *p, int i, const double c[3], bvh_box *b)
         b->hi[a] = up(hi[a] - c[a]);
     }
     return 1;
-}
-
-/* The frame's centre for primitives 0..n-1: the middle of their box in the
- * caller's coordinates, rounded to a multiple of the largest power of two
- * not above the box's longest side.  Coordinates relative to it are then at
- * most that side in magnitude (the rounding moves it by at most half the
- * side), and a scene about the origin gets c = 0 and the very tree it had
- * in the caller's coordinates.  A box of no size (one point) is centred on
- * itself; one that is not finite keeps the origin.  (kdtree.c's frame does
- * the same.) */
-static void frame(const prims *p, int n, double c[3])
-{
-    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, side = 0, unit = 0;
-    int i, a, e, any = 0;
-    for (i = 0; i < n; i++) {
-        double l[3], h[3];
-        p->bounds(p->user, i, l, h);
-        for (a = 0; a < 3; a++)
-            if (!(l[a] <= h[a])) break;
-        if (a < 3) continue;
-        for (a = 0; a < 3; a++) {
-            if (!any || l[a] < lo[a]) lo[a] = l[a];
-            if (!any || h[a] > hi[a]) hi[a] = h[a];
-        }
-        any = 1;
-    }
-    for (a = 0; a < 3; a++)
-        if (hi[a] - lo[a] > side) side = hi[a] - lo[a];
-    if (side > 0 && side <= DBL_MAX) frexp(side, &e), unit = ldexp(1.0, e - 1);
-    for (a = 0; a < 3; a++) {
-        double mid = 0.5 * lo[a] + 0.5 * hi[a];
-        c[a] = !(side <= DBL_MAX) || !isfinite(mid) ? 0 : unit > 0 ? unit * floor(mid / unit + 0.5) : mid;
-    }
 }
 
 static void node_box(bvh_node *nd, const bvh_box *b)
@@ -879,13 +844,13 @@ static double tree_cost4(const bvh *t)
     return sum;
 }
 
-/* The scene box (the root's lanes together) in the frame, and its largest
- * coordinate there and in the caller's coordinates. */
+/* The scene box (the root's lanes together) in the frame, its largest
+ * coordinate there and in the caller's coordinates, and the margin. */
 static void set_scale(bvh *t)
 {
     int a, k;
     bvh_box root, box;
-    t->scale = t->ext = 0;
+    t->scale = t->ext = t->delta = 0;
     for (a = 0; a < 3; a++) t->lo[a] = t->hi[a] = 0;
     if (t->nnodes == 0) return;
     box_empty(&root);
@@ -897,6 +862,7 @@ static void set_scale(bvh *t)
         t->ext = fmax(t->ext, fmax(fabs(t->lo[a]), fabs(t->hi[a])));
         t->scale = fmax(t->scale, fmax(fabs(t->c[a] + t->lo[a]), fabs(t->c[a] + t->hi[a])));
     }
+    t->delta = BVH_EPS * t->ext + t->ulps * t->scale;
 }
 
 /* The tree in one block, the nodes aligned to 64 bytes. */
@@ -970,7 +936,8 @@ bvh *bvh_build(int n, const prims *p, int method)
     b.nodes = calloc(2 * (size_t)n + 2, sizeof *b.nodes);
     ids = malloc(((size_t)n + 1) * sizeof *ids);
     if (b.ref && b.nodes && ids) {
-        frame(p, n, b.c);
+        double lo[3], hi[3];
+        prims_frame(p, n, lo, hi, b.c);
         m = gather(&b, n);
         if (m > 0) {
             bvh_box box, cbox;

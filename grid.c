@@ -44,12 +44,11 @@
 #define MAX_REFS 16
 
 /* The margin:
- *     delta = RAY_EPS * ext + WALK_ULPS DBL_EPSILON * s + ulps * m,
+ *     delta = RAY_EPS * ext + (WALK_ULPS DBL_EPSILON + ulps) * s,
  * ext half the longest side of the scene box, s the largest |coordinate| of
- * the scene box, m the largest of the scene box and of the ray origin.
- * The hit callback's point may lie outside its primitive's box by
- * PRIMS_HIT_REL of the box's longest side (at most 2 ext) plus
- * PRIMS_HIT_ULPS eps m (the contract of prims.h): ulps = PRIMS_HIT_ULPS
+ * the scene box.  The hit callback's point may lie outside its primitive's
+ * box by PRIMS_HIT_REL of the box's longest side (at most 2 ext) plus
+ * PRIMS_HIT_ULPS eps s (the contract of prims.h): ulps = PRIMS_HIT_ULPS
  * eps, and the first is inside RAY_EPS ext, as in kdtree.c.  The grid has
  * no floats and keeps the caller's coordinates: its faces lo + i w, the
  * cells of a point, floor((x - lo) / w), and the DDA's crossings
@@ -57,10 +56,16 @@
  * 2 ext (a point and its cell may disagree by as much), which WALK_ULPS
  * DBL_EPSILON s covers.  That is why an origin farther than 3 ext from the
  * box's middle is first moved along the ray to where the ray enters the
- * box, the sum o + t0 d taken exactly and rounded once (see moved): then
- * o is of the scene's size too, and the walk's t is the caller's t less
- * t0.  A scene far from the origin makes its coordinates' rounding no
- * worse than the callback's own. */
+ * box, the sum o + t0 d taken exactly and rounded once (prims_along,
+ * prims.h): then o is of the scene's size too, and the walk's t is the
+ * caller's t less t0.
+ *
+ * The slack.  The contract also lets the callback's t err along the ray by
+ * ulps m / max|d|, m the larger of s and the origin's largest |coordinate|
+ * (from 10^13 away, t is rounded by 10^-3): the walk takes the ray from
+ * tmin - slack to tmax + slack and stops only before a cell it enters more
+ * than slack beyond the best hit.  A far origin costs a cell now and then
+ * just behind the hit, not a margin across every cell. */
 #define RAY_EPS 2.5e-7
 #define WALK_ULPS 8
 
@@ -82,8 +87,8 @@ struct grid {
     double scale;                  /* largest |coordinate| of the scene box */
     double ext;                    /* half the longest side of the scene box */
     double mid[3];                 /* the scene box's middle */
-    double fixed;                  /* the margin's parts of the scene (see RAY_EPS) */
-    double ulps;                   /* and its factor of m: PRIMS_HIT_ULPS eps */
+    double delta;                  /* the margin (see RAY_EPS) */
+    double ulps;                   /* PRIMS_HIT_ULPS eps: the slack's factor of m */
     double narrow;                 /* the narrowest cell side (of axes cut in two or more) */
     uint32_t *start;               /* cell c lists list[start[c] .. start[c+1]) */
     int *list;
@@ -101,6 +106,7 @@ typedef struct {
     int flat[3];
     double delta;
     double toff;            /* how far along the ray o was moved: the walk's t is the caller's less toff */
+    double slack;           /* how far along the ray a hit's t may err (see RAY_EPS) */
     double t0, t1;          /* the ray inside the grid's grown box */
     int lo[3], hi[3];       /* cells overlapped by the grown point, per axis */
     int skip;
@@ -118,19 +124,6 @@ static double face(const grid *g, int a, int i)
     return g->lo[a] + i * g->w[a];
 }
 
-/* o + t d, each step exact and the sum rounded once: Knuth's TwoSum for
- * the sum, and for the product Dekker's split by a fused multiply-add (the
- * exact product's rounding error is fma(t, d, -t d)).  Rounded step by
- * step, an origin 1e13 away would land off the ray by 1e-3; this way it
- * lands within a rounding of where it lands.  (kdtree.c's moved is the
- * same, less a centre.) */
-static double moved(double o, double t, double d)
-{
-    double p = t * d, pe = fma(t, d, -p);                              /* p + pe = t d */
-    double s = o + p, z = s - o, e = (o - (s - z)) + (p - z);          /* s + e = o + p */
-    return s + (e + pe);
-}
-
 /* Clip the ray to the grid's box grown by delta (the slab test); 0 when it
  * misses it, or when its numbers are out of range for the walk.  An origin
  * from far away is moved first (see RAY_EPS), to where the ray enters the
@@ -138,7 +131,7 @@ static double moved(double o, double t, double d)
 static int setup_ray(const grid *g, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, grid_ray *r)
 {
-    double scale = g->scale, dmax = 0, t0 = tmin, t1 = tmax, far = 0, o[3];
+    double scale = g->scale, dmax = 0, t0, t1, far = 0, o[3];
     int a, pass, move;
     for (a = 0; a < 3; a++) {
         if (fabs(org[a]) > scale) scale = fabs(org[a]);
@@ -146,14 +139,18 @@ static int setup_ray(const grid *g, const double org[3], const double dir[3],
         if (fabs(org[a] - g->mid[a]) > far) far = fabs(org[a] - g->mid[a]);
         o[a] = org[a];
     }
-    r->delta = g->fixed + g->ulps * scale;
+    r->slack = g->ulps * scale / dmax;
+    tmin -= r->slack, tmax += r->slack;
+    t0 = tmin, t1 = tmax;
     r->toff = 0;
     r->skip = skip;
     for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
     move = far > 3 * g->ext;
+    r->delta = g->delta + (move ? g->ulps * scale : 0);   /* a far o's rounding, across the ray too */
     for (pass = move; pass >= 0; pass--) {
         if (pass == 0 && move) {            /* from far away: move the origin to t0 */
-            for (a = 0; a < 3; a++) o[a] = moved(org[a], r->toff, dir[a]);
+            r->delta = g->delta;
+            for (a = 0; a < 3; a++) o[a] = prims_along(org[a], 0, r->toff, dir[a]);
             t0 = tmin - r->toff, t1 = tmax - r->toff;
         }
         for (a = 0; a < 3; a++) {
@@ -266,7 +263,7 @@ static int walk(const grid *g, const prims *p, grid_ray *r, void *ray, double tm
             lag[al] = lag_time(g, r, al);
             continue;
         }
-        if (!(lead[as] <= r->t1) || *best_t - r->toff < lead[as]) break;
+        if (!(lead[as] <= r->t1) || *best_t - r->toff + r->slack < lead[as]) break;
         if (r->d[as] > 0) r->hi[as]++;     /* step: a new slab of cells */
         else r->lo[as]--;
         memcpy(lo, r->lo, sizeof lo), memcpy(hi, r->hi, sizeof hi);
@@ -296,8 +293,9 @@ static int query(const grid *g, const prims *p, const double org[3], const doubl
     if (!(tmin <= *best_t)) return -1;
     if (!setup_ray(g, org, dir, skip, tmin, *best_t, &r)) return -1;
     /* Every primitive, for rays out of range, and where the margin is wider
-     * than half a cell (a scene far from the origin, or a far ray origin):
-     * the walk would visit blocks of cells and gain nothing. */
+     * than half a cell (cells some 10^14 times smaller than the scene's
+     * distance from the origin): the walk would visit blocks of cells and
+     * gain nothing. */
     if (!(s <= FAST_MAX && dmax <= FAST_MAX && dmax >= FAST_MIN) || 2 * r.delta > g->narrow)
         return test_list(g->all, g->nall, p, &r, ray, tmin, any, best_t, -1, c);
     return walk(g, p, &r, ray, tmin, any, best_t, c);
@@ -456,8 +454,8 @@ static long scene_box(grid *g, int n, const prims *p, int *all)
         if (0.5 * (g->hi[a] - g->lo[a]) > g->ext) g->ext = 0.5 * (g->hi[a] - g->lo[a]);
         g->mid[a] = 0.5 * g->lo[a] + 0.5 * g->hi[a];
     }
-    g->fixed = RAY_EPS * g->ext + WALK_ULPS * DBL_EPSILON * g->scale;
     g->ulps = PRIMS_HIT_ULPS * (p->eps > 0 ? p->eps : DBL_EPSILON);
+    g->delta = RAY_EPS * g->ext + (WALK_ULPS * DBL_EPSILON + g->ulps) * g->scale;
     return m;
 }
 

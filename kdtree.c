@@ -106,43 +106,49 @@
 #endif
 
 /* The frame.  The tree keeps its planes and boxes as floats relative to a
- * centre c near the middle of the scene box (see frame), not to the
- * origin: a float step is then 2^-23 of the scene's size wherever the
+ * centre c near the middle of the scene box (prims_frame, prims.h), not to
+ * the origin: a float step is then 2^-23 of the scene's size wherever the
  * scene lies.  In the caller's coordinates a scene 1e8 from the origin
  * would have float steps of 8 units, and a unit-sized scene would collapse
  * into a few of them.
  *
  * The ray's origin goes into the frame too, o - c.  One farther than 2 ext
  * from c (ext below) is first moved along the ray to where the ray enters
- * the scene box, the sum o - c + t0 d taken exactly and rounded once (see
- * moved), and the walk's t is then the caller's t less t0.  So the walk's
+ * the scene box, the sum o - c + t0 d taken exactly and rounded once
+ * (prims_along, prims.h), and the walk's t is then the caller's t less t0.  So the walk's
  * own arithmetic is on numbers of the scene's size wherever the origin is.
  *
  * The margin.  The traversal treats every cell as if it were grown on every
  * side by
- *     delta = RAY_EPS * ext + ulps * m,
- * ext the largest |coordinate| of the scene box in the tree's frame, m the
- * largest |coordinate| of the scene box and of the ray origin in the
- * caller's, and visits every cell whose grown box the ray passes through.
- * Without it a hit lying on a cell boundary could be judged to lie only in
- * the cell that does not list its primitive.  It covers:
+ *     delta = RAY_EPS * ext + ulps * s,
+ * ext the largest |coordinate| of the scene box in the tree's frame, s the
+ * largest in the caller's, and visits every cell whose grown box the ray
+ * passes through.  Without it a hit lying on a cell boundary could be
+ * judged to lie only in the cell that does not list its primitive.  It
+ * covers:
  *   - the boxes and planes, floats rounded to nearest (see kd_box): a
  *     primitive may reach past the cells that list it by half a float
  *     step, at most 2^-24 ext;
  *   - the hit callback's point, outside the primitive's box by up to
- *     PRIMS_HIT_REL times its longest side (at most 2 ext, see frame) plus
- *     PRIMS_HIT_ULPS eps m (the contract of prims.h);
+ *     PRIMS_HIT_REL times its longest side (at most 2 ext, prims_frame)
+ *     plus PRIMS_HIT_ULPS eps s (the contract of prims.h): ulps is
+ *     PRIMS_HIT_ULPS eps;
  *   - the walk's own doubles, all of them of the scene's size: the origin
  *     in the frame (within 3 ext of c, rounded once), each plane crossing
  *     (s - o) / d (three roundings), and the best hit's t less t0 (exact
  *     when t0 is more than half of it, else rounded by 2^-53 of a t inside
  *     the scene): some 10^-15 ext.
  * So RAY_EPS, four times the float rounding, covers the parts of size ext
- * (3 2^-24 ext and the walk's), and ulps = PRIMS_HIT_ULPS eps the part of
- * size m, which is the callback's alone.  The price is an occasional extra
- * cell for rays passing within delta of a boundary: far from the origin,
- * where m is much larger than ext, delta stays a small part of a cell
- * until m is some 10^12 times the scene's size. */
+ * (3 2^-24 ext and the walk's).  The price is an occasional extra cell for
+ * rays passing within delta of a boundary.
+ *
+ * The slack.  The contract lets the callback's t err along the ray by
+ * ulps m / max|d| (m the larger of s and the origin's largest |coordinate|):
+ * a ray from 10^13 away has t of 10^13, rounded by 10^-3.  So the walk
+ * takes the ray from tmin - slack to tmax + slack, slack that much, and
+ * leaves a cell out only when the ray enters it more than slack beyond the
+ * best hit so far.  A far origin costs a few cells just behind the hit,
+ * not a margin across every cell. */
 #define RAY_EPS 2.5e-7
 
 /* ---- nodes ------------------------------------------------------------ */
@@ -177,7 +183,8 @@ struct kd_tree {
     double lo[3], hi[3];  /* scene box, the union of the primitives' boxes, in the frame */
     double ext;      /* largest |coordinate| of the scene box in the frame */
     double scale;    /* largest |coordinate| of the scene box in the caller's coordinates */
-    double ulps;     /* the margin's factor of m: PRIMS_HIT_ULPS eps (see RAY_EPS) */
+    double ulps;     /* PRIMS_HIT_ULPS eps (see RAY_EPS) */
+    double delta;    /* the margin (see RAY_EPS) */
     size_t bytes;
     kd_info info;
 };
@@ -212,6 +219,7 @@ typedef struct {
     int flat[3];
     double delta;
     double toff;    /* how far along the ray the origin was moved */
+    double slack;   /* how far along the ray a hit's t may err (see RAY_EPS) */
     double t0, t1;  /* the part of the ray inside the (grown) scene box */
     int skip;       /* the caller's primitive never to test, or -1 */
     int mail[MAILBOX];
@@ -223,94 +231,76 @@ typedef struct {
     double t0, t1;
 } kd_todo;
 
-/* o - c + t d, each step exact and the sum rounded once: Knuth's TwoSum
- * for the sums, and for the product Dekker's split by a fused multiply-add
- * (the exact product's rounding error is fma(t, d, -t d)).  Rounded step
- * by step, an origin 1e13 away would land off the ray by 1e-3; this way
- * it lands within a rounding of where it lands, a number of the scene's
- * size. */
-static double moved(double o, double c, double t, double d)
-{
-    double s = o - c, z = s - o, e = (o - (s - z)) + (-c - z);         /* s + e = o - c */
-    double p = t * d, pe = fma(t, d, -p);                              /* p + pe = t d */
-    double s2 = s + p, z2 = s2 - s, e2 = (s - (s2 - z2)) + (p - z2);   /* s2 + e2 = s + p */
-    return s2 + (e + e2 + pe);
-}
-
-/* Where the ray o + t d enters the box lo..hi (the slab test of Kay and
- * Kajiya 1986), for t in t0..t1; NaN when it does not. */
-static double entry(const double lo[3], const double hi[3], const double o[3],
-                    const double d[3], double t0, double t1)
+/* The ray from o (in the frame) clipped to the grown scene box, for t in
+ * t0..t1 (the slab test of Kay and Kajiya 1986).  0 when it misses the
+ * box, and for NaN input.  A flat axis needs no division: the ray is inside
+ * that slab for every t or for none. */
+static int clip_ray(const kd_tree *t, const double o[3], const double dir[3],
+                    double t0, double t1, kd_ray *r)
 {
     int a;
     for (a = 0; a < 3; a++) {
-        double ta, tb, inv;
-        if (d[a] == 0) {
-            if (!(o[a] >= lo[a] && o[a] <= hi[a])) return NAN;
-            continue;
-        }
-        inv = 1 / d[a];
-        ta = (lo[a] - o[a]) * inv, tb = (hi[a] - o[a]) * inv;
-        if (ta > tb) inv = ta, ta = tb, tb = inv;
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
-    }
-    return t0 <= t1 ? t0 : NAN;
-}
-
-/* Set up the ray and clip it to the grown scene box (the slab test of Kay
- * and Kajiya 1986).  0 when it misses the box, and for NaN or infinite
- * input.  A flat axis needs no division: the ray is inside that slab for
- * every t or for none.  Half the rays of a typical view miss the scene box
- * and cost nothing else, so this is kept to one pass over the axes, but
- * for an origin from far away, which is first moved (see RAY_EPS). */
-static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
-                     int skip, double tmin, double tmax, kd_ray *r)
-{
-    double scale = t->scale, t0, t1, ol[3], far = 0;
-    int a;
-    r->skip = skip;
-    r->toff = 0;
-    for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
-    for (a = 0; a < 3; a++) {
-        double m = fabs(org[a]);
-        if (!(m <= DBL_MAX) || !isfinite(dir[a])) return 0;
-        if (m > scale) scale = m;
-        ol[a] = org[a] - t->c[a];
-        if (fabs(ol[a]) > far) far = fabs(ol[a]);
-    }
-    r->delta = RAY_EPS * t->ext + t->ulps * scale;
-    if (far > 2 * t->ext) {
-        double lo[3], hi[3];
-        for (a = 0; a < 3; a++) lo[a] = t->lo[a] - r->delta, hi[a] = t->hi[a] + r->delta;
-        r->toff = entry(lo, hi, ol, dir, tmin, tmax);
-        if (!(r->toff <= tmax)) return 0;   /* misses the box, or NaN */
-        for (a = 0; a < 3; a++) ol[a] = moved(org[a], t->c[a], r->toff, dir[a]);
-        tmin -= r->toff, tmax -= r->toff;
-    }
-    t0 = tmin, t1 = tmax;
-    for (a = 0; a < 3; a++) {
-        double o = ol[a], d = dir[a], lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta;
+        double d = dir[a], lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta;
         double inv, ta, tb;
         int neg = signbit(d) != 0;
-        r->org[a] = o;
+        r->org[a] = o[a];
         r->neg[a] = (uint32_t)neg;
         r->flat[a] = d == 0;
         if (d == 0) {
             r->inv[a] = neg ? -HUGE_VAL : HUGE_VAL;
             r->pad[a] = 0;
-            if (!(o >= lo && o <= hi)) return 0;
+            if (!(o[a] >= lo && o[a] <= hi)) return 0;
             continue;
         }
         r->inv[a] = inv = 1.0 / d;
         r->pad[a] = r->delta * fabs(inv);
-        ta = ((neg ? hi : lo) - o) * inv;
-        tb = ((neg ? lo : hi) - o) * inv;
+        ta = ((neg ? hi : lo) - o[a]) * inv;
+        tb = ((neg ? lo : hi) - o[a]) * inv;
         if (ta > t0) t0 = ta;
         if (tb < t1) t1 = tb;
     }
     r->t0 = t0, r->t1 = t1;
     return t0 <= t1;  /* false for NaN in tmin or tmax */
+}
+
+/* Set up the ray and clip it to the grown scene box; 0 when it misses, and
+ * for NaN or infinite input.  Half the rays of a typical view miss the
+ * scene box and cost nothing else, so this is one pass over the axes, and
+ * a second for an origin from far away, moved to where the first found the
+ * ray entering the box (see the frame, above RAY_EPS). */
+static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
+                     int skip, double tmin, double tmax, kd_ray *r)
+{
+    double m = t->scale, dmax = 0, ol[3], far = 0;
+    int a;
+    r->skip = skip;
+    r->toff = 0;
+    for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
+    for (a = 0; a < 3; a++) {
+        if (!(fabs(org[a]) <= DBL_MAX) || !isfinite(dir[a])) return 0;
+        if (fabs(org[a]) > m) m = fabs(org[a]);
+        if (fabs(dir[a]) > dmax) dmax = fabs(dir[a]);
+        ol[a] = org[a] - t->c[a];
+        if (fabs(ol[a]) > far) far = fabs(ol[a]);
+    }
+    r->slack = t->ulps * m / dmax;          /* +inf for a zero direction */
+    tmin -= r->slack, tmax += r->slack;
+    /* A far origin in the frame is rounded by a few eps m, across the ray
+     * too: the box it is clipped to grows by as much. */
+    r->delta = far > 2 * t->ext ? t->delta + t->ulps * m : t->delta;
+    if (!clip_ray(t, ol, dir, tmin, tmax, r)) return 0;
+    if (!(far > 2 * t->ext)) return 1;
+    r->delta = t->delta;
+    r->toff = r->t0;
+    for (a = 0; a < 3; a++) ol[a] = prims_along(org[a], t->c[a], r->toff, dir[a]);
+    return clip_ray(t, ol, dir, tmin - r->toff, tmax - r->toff, r);
+}
+
+/* The latest t of the walk's (see setup_ray) at which the point of a hit at
+ * the caller's t may lie. */
+static inline double reach(const kd_ray *r, double t)
+{
+    return t - r->toff + r->slack;
 }
 
 static void push(kd_todo *stack, int *n, uint32_t node, double t0, double t1)
@@ -408,7 +398,7 @@ static int tree_intersect(const kd_tree *t, const prims *p, kd_ray *r,
         return test_leaf(t, nd, p, r, ray, tmin, any, best_t, best, &c->tests);
     w.node = step(nd, r, &w.t0, &w.t1, &far, &n);
     best = tree_intersect(t, p, r, ray, tmin, any, w, best_t, best, c);
-    if ((any && best >= 0) || pop(&far, &n, *best_t - r->toff) < 0) return best;
+    if ((any && best >= 0) || pop(&far, &n, reach(r, *best_t)) < 0) return best;
     return tree_intersect(t, p, r, ray, tmin, any, far, best_t, best, c);
 }
 
@@ -438,7 +428,7 @@ static int walk(const kd_tree *t, const prims *p, kd_ray *r,
         }
         best = test_leaf(t, nd, p, r, ray, tmin, any, best_t, best, &tests);
         if (any && best >= 0) break;
-        next = pop(stack, &n, *best_t - r->toff);
+        next = pop(stack, &n, reach(r, *best_t));
         if (next < 0) break;
         node = stack[next].node, t0 = stack[next].t0, t1 = stack[next].t1;
     }
@@ -523,26 +513,6 @@ static int make_box(const double lo[3], const double hi[3], const double c[3], k
         b->hi[a] = to_float(hi[a] - c[a]);
     }
     return 1;
-}
-
-/* The frame's centre for a scene box lo..hi: its middle, rounded to a
- * multiple of the largest power of two not above the box's longest side.
- * Coordinates relative to it are then at most that side in magnitude (the
- * rounding moves it by at most half the side), and a scene about the
- * origin gets c = 0 and the very tree it had in the caller's coordinates.
- * A box of no size (one point) is centred on itself; one that is not
- * finite keeps the origin. */
-static void frame(const double lo[3], const double hi[3], double c[3])
-{
-    double side = 0, unit = 0;
-    int a, e;
-    for (a = 0; a < 3; a++)
-        if (hi[a] - lo[a] > side) side = hi[a] - lo[a];
-    if (side > 0 && side <= DBL_MAX) frexp(side, &e), unit = ldexp(1.0, e - 1);
-    for (a = 0; a < 3; a++) {
-        double mid = 0.5 * lo[a] + 0.5 * hi[a];
-        c[a] = !(side <= DBL_MAX) || !isfinite(mid) ? 0 : unit > 0 ? unit * floor(mid / unit + 0.5) : mid;
-    }
 }
 
 static double box_area(const kd_box *b)
@@ -1178,34 +1148,13 @@ static void build_node(kd_builder *b, long at, kd_list *L, const kd_box *v,
     build_node(b, child + 1, &right, &vr, depth + 1, budget - share);
 }
 
-/* The scene box in the caller's coordinates, and the frame it gives (one
- * more call of bounds per primitive: cheaper than keeping every box). */
-static void scene_frame(kd_builder *b, int n)
-{
-    int i, a, any = 0;
-    for (a = 0; a < 3; a++) b->wlo[a] = b->whi[a] = 0;
-    for (i = 0; i < n; i++) {
-        double lo[3], hi[3];
-        b->p->bounds(b->p->user, i, lo, hi);
-        for (a = 0; a < 3; a++)
-            if (!(lo[a] <= hi[a])) break;
-        if (a < 3) continue;
-        for (a = 0; a < 3; a++) {
-            if (!any || lo[a] < b->wlo[a]) b->wlo[a] = lo[a];
-            if (!any || hi[a] > b->whi[a]) b->whi[a] = hi[a];
-        }
-        any = 1;
-    }
-    frame(b->wlo, b->whi, b->c);
-}
-
 /* The events of all primitives, sorted once: the only full sort. */
 static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
 {
     int i, a;
     memset(scene, 0, sizeof *scene);
     if (!alloc_list(L, 2 * (long)n)) return 0;
-    scene_frame(b, n);
+    prims_frame(b->p, n, b->wlo, b->whi, b->c);   /* one more call of bounds per primitive */
     for (i = 0; i < n; i++) {
         double lo[3], hi[3];
         kd_box box;
@@ -1247,6 +1196,7 @@ static kd_tree *finish(kd_builder *b, const kd_box *scene)
         t->scale = fmax(t->scale, fmax(fabs(b->wlo[a]), fabs(b->whi[a])));
     }
     t->ulps = PRIMS_HIT_ULPS * (b->p->eps > 0 ? b->p->eps : DBL_EPSILON);
+    t->delta = RAY_EPS * t->ext + t->ulps * t->scale;
     t->info = b->info;
     t->info.bytes = t->bytes;
     t->info.prims_per_leaf = t->info.leaves > t->info.empty_leaves
