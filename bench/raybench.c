@@ -201,42 +201,69 @@ static int rb_nff_view(const char *path, double eye[3], double at[3], double up[
     return got == 4;
 }
 
-/* Primary rays by embree_rays' stated pinhole convention: without a view,
- * looking down -z at the box centre from where the bounding sphere just
- * fills the 45-degree vertical field of view; with one, the NFF camera. */
-static RbRay *rb_primary(const Scene *s, int w, int h, const char *view)
+/* The camera of the primary rays, by embree_rays' stated pinhole
+ * convention: without a view, looking down -z at the box centre from where
+ * the bounding sphere just fills the 45-degree vertical field of view; with
+ * one, the NFF camera.  dist > 0 moves the eye back along its line of sight
+ * to dist from the point it looks at, the field of view narrowed to frame
+ * the same picture (raybench far). */
+typedef struct { double eye[3], f[3], r[3], u[3], th; } RbCamera;
+
+static RbCamera rb_camera(const Scene *s, const char *view, double dist)
 {
     RbBox b = rb_box(s);
-    double eye[3], at[3], up[3] = { 0, 1, 0 }, f[3], r[3], u[3], fov = 45, th;
+    RbCamera c;
+    double at[3], up[3] = { 0, 1, 0 }, fov = 45, len;
+    int k;
+    if (view) {
+        if (!rb_nff_view(view, c.eye, at, up, &fov)) rb_die("no from, at, up and angle in", view);
+    } else {
+        double d0 = b.R / sin(0.5 * fov * RB_PI / 180);
+        for (k = 0; k < 3; k++) at[k] = b.c[k];
+        c.eye[0] = b.c[0]; c.eye[1] = b.c[1]; c.eye[2] = b.c[2] + d0;   /* dir (0, 0, -1) */
+    }
+    c.th = tan(0.5 * fov * RB_PI / 180);
+    for (k = 0; k < 3; k++) c.f[k] = at[k] - c.eye[k];
+    if (dist > 0) {
+        len = sqrt(c.f[0] * c.f[0] + c.f[1] * c.f[1] + c.f[2] * c.f[2]);
+        for (k = 0; k < 3; k++) c.eye[k] = at[k] - c.f[k] / len * dist;
+        c.th *= len / dist;
+    }
+    rb_norm(c.f);
+    rb_cross(c.f, up, c.r);
+    if (sqrt(c.r[0] * c.r[0] + c.r[1] * c.r[1] + c.r[2] * c.r[2]) < 1e-6) {  /* up along the view */
+        double up2[3] = { 0, 0, 1 };
+        if (fabs(c.f[2]) > 0.9) up2[1] = 1, up2[2] = 0;
+        rb_cross(c.f, up2, c.r);
+    }
+    rb_norm(c.r);
+    rb_cross(c.r, c.f, c.u);
+    return c;
+}
+
+/* The unit direction through the centre of pixel x, y of w x h. */
+static void rb_pixel(const RbCamera *c, int w, int h, int x, int y, double d[3])
+{
+    double sx = (2.0 * (x + 0.5) / w - 1) * c->th * ((double)w / h);
+    double sy = (1 - 2.0 * (y + 0.5) / h) * c->th;
+    int k;
+    for (k = 0; k < 3; k++) d[k] = c->f[k] + sx * c->r[k] + sy * c->u[k];
+    rb_norm(d);
+}
+
+/* W x H primary rays from the camera (rb_camera). */
+static RbRay *rb_primary(const Scene *s, int w, int h, const char *view)
+{
+    RbCamera c = rb_camera(s, view, 0);
     RbRay *rays = malloc((size_t)w * h * sizeof *rays);
     int x, y, k;
     if (!rays) rb_die("out of memory for primary rays", NULL);
-    if (view) {
-        if (!rb_nff_view(view, eye, at, up, &fov)) rb_die("no from, at, up and angle in", view);
-    } else {
-        double dist = b.R / sin(0.5 * fov * RB_PI / 180);
-        for (k = 0; k < 3; k++) at[k] = b.c[k];
-        eye[0] = b.c[0]; eye[1] = b.c[1]; eye[2] = b.c[2] + dist;   /* dir (0, 0, -1) */
-    }
-    th = tan(0.5 * fov * RB_PI / 180);
-    for (k = 0; k < 3; k++) f[k] = at[k] - eye[k];
-    rb_norm(f);
-    rb_cross(f, up, r);
-    if (sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) < 1e-6) {  /* up along the view */
-        double up2[3] = { 0, 0, 1 };
-        if (fabs(f[2]) > 0.9) up2[1] = 1, up2[2] = 0;
-        rb_cross(f, up2, r);
-    }
-    rb_norm(r);
-    rb_cross(r, f, u);
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            double sx = (2.0 * (x + 0.5) / w - 1) * th * ((double)w / h);
-            double sy = (1 - 2.0 * (y + 0.5) / h) * th, d[3];
+            double d[3];
             RbRay *ry = &rays[(size_t)y * w + x];
-            for (k = 0; k < 3; k++) d[k] = f[k] + sx * r[k] + sy * u[k];
-            rb_norm(d);
-            for (k = 0; k < 3; k++) ry->o[k] = (float)eye[k], ry->d[k] = (float)d[k];
+            rb_pixel(&c, w, h, x, y, d);
+            for (k = 0; k < 3; k++) ry->o[k] = (float)c.eye[k], ry->d[k] = (float)d[k];
             ry->t = 0;
             ry->prim = -2;
         }
@@ -1088,67 +1115,33 @@ static void rb_far_translate(Scene *s, double off)
 }
 
 /* Primary rays as rb_primary makes them, in double, from a camera moved by
- * off, or moved back along its line of sight to dist from `at` (0: where
- * the scene puts it) with the field of view narrowed to match. */
+ * off, or moved back to dist from the point it looks at (rb_camera). */
 static RbDRay *rb_far_primary(const Scene *s, int w, int h, const char *view, double off, double dist)
 {
-    RbBox b = rb_box(s);
-    double eye[3], at[3], up[3] = { 0, 1, 0 }, f[3], r[3], u[3], fov = 45, th, back[3], len;
+    RbCamera c = rb_camera(s, view, dist);
     RbDRay *rays = malloc((size_t)w * h * sizeof *rays);
     int x, y, k;
     if (!rays) rb_die("out of memory for primary rays", NULL);
-    if (view) {
-        if (!rb_nff_view(view, eye, at, up, &fov)) rb_die("no from, at, up and angle in", view);
-    } else {
-        double d0 = b.R / sin(0.5 * fov * RB_PI / 180);
-        for (k = 0; k < 3; k++) at[k] = eye[k] = b.c[k];
-        eye[2] += d0;
-    }
-    th = tan(0.5 * fov * RB_PI / 180);
-    for (k = 0; k < 3; k++) back[k] = eye[k] - at[k];
-    len = sqrt(back[0] * back[0] + back[1] * back[1] + back[2] * back[2]);
-    if (dist > 0) {
-        for (k = 0; k < 3; k++) eye[k] = at[k] + back[k] / len * dist;
-        th *= len / dist;
-    }
-    for (k = 0; k < 3; k++) f[k] = at[k] - eye[k];
-    rb_norm(f);
-    rb_cross(f, up, r);
-    if (sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) < 1e-6) {
-        double up2[3] = { 0, 0, 1 };
-        if (fabs(f[2]) > 0.9) up2[1] = 1, up2[2] = 0;
-        rb_cross(f, up2, r);
-    }
-    rb_norm(r);
-    rb_cross(r, f, u);
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            double sx = (2.0 * (x + 0.5) / w - 1) * th * ((double)w / h);
-            double sy = (1 - 2.0 * (y + 0.5) / h) * th;
             RbDRay *ry = &rays[(size_t)y * w + x];
-            for (k = 0; k < 3; k++) ry->d[k] = f[k] + sx * r[k] + sy * u[k], ry->o[k] = eye[k] + off;
-            rb_norm(ry->d);
+            rb_pixel(&c, w, h, x, y, ry->d);
+            for (k = 0; k < 3; k++) ry->o[k] = c.eye[k] + off;
         }
     return rays;
 }
 
-/* rb_random's rays in double, moved by off. */
+/* rb_random's rays (seed 1), in double, moved by off. */
 static RbDRay *rb_far_random(const Scene *s, long n, double off)
 {
-    RbBox b = rb_box(s);
+    RbRay *r = rb_random(s, n, 1);
     RbDRay *rays = malloc((size_t)n * sizeof *rays);
     long i;
     int k;
     if (!rays) rb_die("out of memory for random rays", NULL);
-    rb_state = 1;
-    for (i = 0; i < n; i++) {
-        double z, phi, sz;
-        for (k = 0; k < 3; k++) rays[i].o[k] = b.c[k] + (2 * rb_uniform() - 1) * b.he[k] * 1.5 + off;
-        z = 2 * rb_uniform() - 1;
-        phi = 2 * RB_PI * rb_uniform();
-        sz = sqrt(1 - z * z);
-        rays[i].d[0] = sz * cos(phi), rays[i].d[1] = sz * sin(phi), rays[i].d[2] = z;
-    }
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) rays[i].o[k] = r[i].o[k] + off, rays[i].d[k] = r[i].d[k];
+    free(r);
     return rays;
 }
 
