@@ -433,22 +433,25 @@ int bvh_intersect_recursive(const bvh *t, const prims *p, const double org[3],
 
 /* ---- boxes -------------------------------------------------------------- */
 
+/* A box as the build keeps it: four lanes, the fourth a copy of the
+ * third, so that the compiler can grow one with a single vector minimum and
+ * maximum. */
 typedef struct {
-    float lo[3], hi[3];
+    float lo[4], hi[4];
 } bvh_box;
 
 static void box_empty(bvh_box *b)
 {
     int a;
-    for (a = 0; a < 3; a++) b->lo[a] = HUGE_VALF, b->hi[a] = -HUGE_VALF;
+    for (a = 0; a < 4; a++) b->lo[a] = HUGE_VALF, b->hi[a] = -HUGE_VALF;
 }
 
 static void box_grow(bvh_box *b, const bvh_box *c)
 {
     int a;
-    for (a = 0; a < 3; a++) {
-        if (c->lo[a] < b->lo[a]) b->lo[a] = c->lo[a];
-        if (c->hi[a] > b->hi[a]) b->hi[a] = c->hi[a];
+    for (a = 0; a < 4; a++) {
+        b->lo[a] = c->lo[a] < b->lo[a] ? c->lo[a] : b->lo[a];
+        b->hi[a] = c->hi[a] > b->hi[a] ? c->hi[a] : b->hi[a];
     }
 }
 
@@ -474,19 +477,21 @@ static int prim_box(const prims *p, int i, const double c[3], bvh_box *b)
         b->lo[a] = down(lo[a] - c[a]);
         b->hi[a] = up(hi[a] - c[a]);
     }
+    b->lo[3] = b->lo[2], b->hi[3] = b->hi[2];
     return 1;
 }
 
 static void node_box(bvh_node *nd, const bvh_box *b)
 {
-    memcpy(nd->box[0], b->lo, sizeof b->lo);
-    memcpy(nd->box[1], b->hi, sizeof b->hi);
+    memcpy(nd->box[0], b->lo, sizeof nd->box[0]);
+    memcpy(nd->box[1], b->hi, sizeof nd->box[1]);
 }
 
 static void node_to_box(const bvh_node *nd, bvh_box *b)
 {
-    memcpy(b->lo, nd->box[0], sizeof b->lo);
-    memcpy(b->hi, nd->box[1], sizeof b->hi);
+    memcpy(b->lo, nd->box[0], sizeof nd->box[0]);
+    memcpy(b->hi, nd->box[1], sizeof nd->box[1]);
+    b->lo[3] = b->lo[2], b->hi[3] = b->hi[2];
 }
 
 /* ---- the builder -------------------------------------------------------- */
@@ -515,16 +520,21 @@ typedef struct {
 
 static float centroid2(const bvh_ref *r, int a) { return r->lo[a] + r->hi[a]; }
 
+/* The record's box as a four-lane box. */
+static void ref_box(const bvh_ref *r, bvh_box *b)
+{
+    b->lo[0] = r->lo[0], b->lo[1] = r->lo[1], b->lo[2] = b->lo[3] = r->lo[2];
+    b->hi[0] = r->hi[0], b->hi[1] = r->hi[1], b->hi[2] = b->hi[3] = r->hi[2];
+}
+
 static void grow_ref(bvh_box *box, bvh_box *cbox, const bvh_ref *r)
 {
+    bvh_box rb, c;
     int a;
-    for (a = 0; a < 3; a++) {
-        float c = centroid2(r, a);
-        box->lo[a] = r->lo[a] < box->lo[a] ? r->lo[a] : box->lo[a];
-        box->hi[a] = r->hi[a] > box->hi[a] ? r->hi[a] : box->hi[a];
-        cbox->lo[a] = c < cbox->lo[a] ? c : cbox->lo[a];
-        cbox->hi[a] = c > cbox->hi[a] ? c : cbox->hi[a];
-    }
+    ref_box(r, &rb);
+    for (a = 0; a < 4; a++) c.lo[a] = c.hi[a] = rb.lo[a] + rb.hi[a];
+    box_grow(box, &rb);
+    box_grow(cbox, &c);
 }
 
 /* The box of primitives first..first+n-1, and the box of their doubled
@@ -574,13 +584,11 @@ static double best_bin_split(const bvh_builder *b, long first, long n,
     }
     for (k = first; k < first + n; k++) {
         const bvh_ref *r = &b->ref[k];
+        bvh_box rb;
+        ref_box(r, &rb);
         for (a = 0; a < 3; a++) {
-            int j = bin_of(centroid2(r, a), cbox->lo[a], k1[a], nb), c;
-            bvh_box *x = &bin[a][j];
-            for (c = 0; c < 3; c++) {   /* min and max without a branch */
-                x->lo[c] = r->lo[c] < x->lo[c] ? r->lo[c] : x->lo[c];
-                x->hi[c] = r->hi[c] > x->hi[c] ? r->hi[c] : x->hi[c];
-            }
+            int j = bin_of(centroid2(r, a), cbox->lo[a], k1[a], nb);
+            box_grow(&bin[a][j], &rb);
             count[a][j]++;
         }
     }
@@ -759,6 +767,7 @@ static void lane_to_box(const bvh_node4 *nd, int k, bvh_box *b)
 {
     int a;
     for (a = 0; a < 3; a++) b->lo[a] = nd->box[0][a][k], b->hi[a] = nd->box[1][a][k];
+    b->lo[3] = b->lo[2], b->hi[3] = b->hi[2];
 }
 
 static int lane_empty(const bvh_node4 *nd, int k)
@@ -914,8 +923,8 @@ static long gather(bvh_builder *b, int n)
     for (i = 0; i < n; i++) {
         bvh_box box;
         if (!prim_box(b->p, i, b->c, &box)) continue;
-        memcpy(b->ref[m].lo, box.lo, sizeof box.lo);
-        memcpy(b->ref[m].hi, box.hi, sizeof box.hi);
+        memcpy(b->ref[m].lo, box.lo, sizeof b->ref[m].lo);
+        memcpy(b->ref[m].hi, box.hi, sizeof b->ref[m].hi);
         b->ref[m].id = i, b->ref[m].pad = 0;
         m++;
     }
