@@ -59,8 +59,8 @@
 #define STACK_SIZE 96
 
 /* The frame.  Boxes are floats relative to a centre c near the middle of
- * the scene box (prims_frame, prims.h), not to the origin, so that a float step is
- * 2^-23 of the scene's size wherever the scene lies; they are rounded
+ * the scene box (prims_frame, prims.h), not to the origin, so that a float
+ * step is 2^-23 of the scene's size wherever the scene lies; they are rounded
  * outwards, so each holds its primitives' double boxes whole (give or take
  * the rounding of x - c in double, 2^-53 ext).
  *
@@ -71,17 +71,19 @@
  * primitive's box by PRIMS_HIT_REL of the box's longest side (at most
  * 2 ext) plus PRIMS_HIT_ULPS eps s (the contract of prims.h; ulps is
  * PRIMS_HIT_ULPS eps).  The slab test runs in float in the frame, from an
- * origin within 2 ext of the frame's centre (setup_ray moves a farther one
- * along the ray to where it enters the grown scene box): b - o rounds by
- * 2^-24 of |b - o| <= 3 ext, d to float, 1/d and the product by 2^-24
- * each, so a computed crossing may be off by 4 * 2^-24 * 3 ext =
- * 7.2e-7 ext in space.  With the callback's 2 * 2^-24 ext, 8.3e-7 ext;
- * BVH_EPS = 2^-20 = 9.5e-7 covers them.  The origin shifted by delta is
+ * origin o at most D from the frame's centre: b - o rounds by 2^-24 of
+ * |b - o| <= D + ext, d to float, 1/d and the product by 2^-24 each, so a
+ * computed crossing may be off by 4 * 2^-24 (D + ext) in space.  For
+ * D <= 2 ext that is 7.2e-7 ext, with the callback's 2 * 2^-24 ext
+ * 8.3e-7 ext, which BVH_EPS = 2^-20 = 9.5e-7 covers; a farther origin (a
+ * camera looking at the scene) adds BVH_EPS D / 2 to the margin for the
+ * rest, and one farther than FAR_MOVE ext is moved along the ray to where
+ * it enters the grown scene box (setup_ray), and is within 2 ext again.  The origin shifted by delta is
  * rounded away from the box (see setup_ray), so its own rounding only adds
  * margin.  The origin moved along the ray, o - c + t0 d, is summed exactly
  * and rounded once (prims_along, prims.h), so it lies on the ray to within
- * a rounding of a number of the scene's size; the walk's t is then the caller's t
- * less t0, taken in double (exact when t0 is more than half of it) before
+ * a rounding of a number of the scene's size; the walk's t is then the
+ * caller's t less t0, taken in double (exact when t0 is more than half of it) before
  * it is rounded up to a float.
  *
  * The slack.  The contract also lets the callback's t err along the ray by
@@ -95,6 +97,7 @@
  * range (FAST_MAX below); other rays are answered by testing every
  * primitive. */
 #define BVH_EPS (1.0 / 1048576.0)
+#define FAR_MOVE 64
 #define FAST_MAX 0x1p60
 #define FAST_MIN 0x1p-60
 
@@ -141,6 +144,7 @@ struct bvh {
     double scale;      /* largest |coordinate| of the root's boxes in the caller's coordinates */
     double ulps;       /* PRIMS_HIT_ULPS eps (see BVH_EPS) */
     double delta;      /* the margin (see BVH_EPS) */
+    double slack_ulps; /* ulps, and 2^-21 more for a float 1/d (setup_ray) */
     bvh_info info;
 };
 
@@ -192,15 +196,16 @@ typedef struct {
 /* The ray set up for the float slab test: 1, or 0 when its numbers leave
  * the test's range (see BVH_EPS), or -1 when it can hit nothing: NaN or
  * infinite input, or a ray from far away that misses the scene box.  The
- * origin goes into the frame; one farther than 2 ext from its centre is
- * moved along the ray to where the ray enters the grown scene box (the
- * slab test of Kay and Kajiya 1986, in double), so that the float test
- * sees numbers of the scene's size: from 1e13 away a float would hold the
- * origin only to 1e6. */
+ * origin goes into the frame; one farther than FAR_MOVE ext from its
+ * centre is moved along the ray to where the ray enters the grown scene
+ * box (the slab test of Kay and Kajiya 1986, in double), so that the float
+ * test sees numbers of the scene's size: from 1e13 away a float would hold
+ * the origin only to 1e6. */
 static int setup_ray(const bvh *t, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, bvh_ray *r)
 {
     double scale = t->scale, dmax = 0, delta = t->delta, o[3], far = 0;
+    float least = HUGE_VALF;
     int a;
     for (a = 0; a < 3; a++) {
         double m = fabs(org[a]), d = fabs(dir[a]);
@@ -209,14 +214,20 @@ static int setup_ray(const bvh *t, const double org[3], const double dir[3],
         if (d > dmax) dmax = d;
         o[a] = org[a] - t->c[a];
         if (fabs(o[a]) > far) far = fabs(o[a]);
+        r->inv[a] = 1.0f / (float)dir[a];    /* +-inf for +-0 and tiny d */
+        if (fabsf(r->inv[a]) < least) least = fabsf(r->inv[a]);
     }
     r->skip = skip;
     if (!(scale <= FAST_MAX && scale >= FAST_MIN && dmax <= FAST_MAX && dmax >= FAST_MIN))
         return 0;
-    r->slack = t->ulps * scale / dmax;
+    /* 1 / max|d| is the least |1/d|, rounded twice to float: slack_ulps
+     * allows for that (no division of its own) */
+    r->slack = t->slack_ulps * scale * least;
     r->toff = 0;
     tmin -= r->slack;
-    if (far > 2 * t->ext) {
+    if (far > 2 * t->ext && !(far > FAR_MOVE * t->ext))   /* a camera looking on */
+        delta += 0.5 * BVH_EPS * far;       /* see BVH_EPS */
+    else if (far > FAR_MOVE * t->ext) {
         double t0 = tmin, t1 = tmax + r->slack;
         double grow = delta + t->ulps * scale;   /* o is rounded by a few eps m */
         for (a = 0; a < 3; a++) {
@@ -240,7 +251,6 @@ static int setup_ray(const bvh *t, const double org[3], const double dir[3],
         r->neg[a] = neg;
         r->on[a] = neg ? down(o[a] - delta) : up(o[a] + delta);
         r->of[a] = neg ? up(o[a] + delta) : down(o[a] - delta);
-        r->inv[a] = 1.0f / (float)dir[a];    /* +-inf for +-0 and tiny d */
     }
     r->tmin = down(tmin - r->toff);
     return 1;
@@ -903,6 +913,7 @@ static bvh *finish(bvh_builder *b, const int *ids, long nprims)
     t->prims = (int *)(t->nodes + used);
     memcpy(t->c, b->c, sizeof t->c);
     t->ulps = PRIMS_HIT_ULPS * (b->p->eps > 0 ? b->p->eps : DBL_EPSILON);
+    t->slack_ulps = t->ulps * (1 + 0x1p-21);
     set_scale(t);
     t->info.nodes = used;
     t->info.leaves = b->leaves;

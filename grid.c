@@ -54,11 +54,11 @@
  * cells of a point, floor((x - lo) / w), and the DDA's crossings
  * (face - o) / d are doubles, a few roundings each of numbers below 2s +
  * 2 ext (a point and its cell may disagree by as much), which WALK_ULPS
- * DBL_EPSILON s covers.  That is why an origin farther than 3 ext from the
- * box's middle is first moved along the ray to where the ray enters the
- * box, the sum o + t0 d taken exactly and rounded once (prims_along,
- * prims.h): then o is of the scene's size too, and the walk's t is the
- * caller's t less t0.
+ * DBL_EPSILON s covers.  An origin at D from the box's middle adds a few
+ * 2^-53 D, inside RAY_EPS ext while D is below FAR_MOVE ext: a farther one
+ * is first moved along the ray to where the ray enters the box, the sum
+ * o + t0 d taken exactly and rounded once (prims_along, prims.h), and the
+ * walk's t is then the caller's t less t0.
  *
  * The slack.  The contract also lets the callback's t err along the ray by
  * ulps m / max|d|, m the larger of s and the origin's largest |coordinate|
@@ -68,6 +68,7 @@
  * just behind the hit, not a margin across every cell. */
 #define RAY_EPS 2.5e-7
 #define WALK_ULPS 8
+#define FAR_MOVE 0x1p20
 
 /* Each ray keeps the last primitive tested in each of MAILBOX slots chosen
  * by the primitive's number (Amanatides & Woo 1987): an object in several
@@ -131,7 +132,7 @@ static double face(const grid *g, int a, int i)
 static int setup_ray(const grid *g, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, grid_ray *r)
 {
-    double scale = g->scale, dmax = 0, t0, t1, far = 0, o[3];
+    double scale = g->scale, dmax = 0, t0, t1, far = 0, o[3], least = HUGE_VAL;
     int a, pass, move;
     for (a = 0; a < 3; a++) {
         if (fabs(org[a]) > scale) scale = fabs(org[a]);
@@ -139,13 +140,20 @@ static int setup_ray(const grid *g, const double org[3], const double dir[3],
         if (fabs(org[a] - g->mid[a]) > far) far = fabs(org[a] - g->mid[a]);
         o[a] = org[a];
     }
-    r->slack = g->ulps * scale / dmax;
+    for (a = 0; a < 3; a++) {
+        r->d[a] = dir[a];
+        r->flat[a] = !(fabs(dir[a]) > FLAT * dmax);
+        r->inv[a] = r->flat[a] ? 0 : 1 / dir[a];
+        if (!r->flat[a] && fabs(r->inv[a]) < least) least = fabs(r->inv[a]);
+    }
+    r->slack = g->ulps * scale * least;     /* 1 / max|d|, no division of its own */
+    if (!(r->slack >= 0)) r->slack = HUGE_VAL;
     tmin -= r->slack, tmax += r->slack;
     t0 = tmin, t1 = tmax;
     r->toff = 0;
     r->skip = skip;
     for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
-    move = far > 3 * g->ext;
+    move = far > FAR_MOVE * g->ext;
     r->delta = g->delta + (move ? g->ulps * scale : 0);   /* a far o's rounding, across the ray too */
     for (pass = move; pass >= 0; pass--) {
         if (pass == 0 && move) {            /* from far away: move the origin to t0 */
@@ -155,14 +163,11 @@ static int setup_ray(const grid *g, const double org[3], const double dir[3],
         }
         for (a = 0; a < 3; a++) {
             double lo = g->lo[a] - r->delta, hi = g->hi[a] + r->delta, ta, tb;
-            r->o[a] = o[a], r->d[a] = dir[a];
-            r->flat[a] = !(fabs(dir[a]) > FLAT * dmax);
+            r->o[a] = o[a];
             if (r->flat[a]) {
-                r->inv[a] = 0;
                 if (!(o[a] >= lo && o[a] <= hi)) return 0;
                 continue;
             }
-            r->inv[a] = 1 / dir[a];
             ta = (lo - o[a]) * r->inv[a], tb = (hi - o[a]) * r->inv[a];
             if (ta > tb) { double s = ta; ta = tb; tb = s; }
             if (ta > t0) t0 = ta;

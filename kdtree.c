@@ -112,11 +112,14 @@
  * would have float steps of 8 units, and a unit-sized scene would collapse
  * into a few of them.
  *
- * The ray's origin goes into the frame too, o - c.  One farther than 2 ext
- * from c (ext below) is first moved along the ray to where the ray enters
- * the scene box, the sum o - c + t0 d taken exactly and rounded once
- * (prims_along, prims.h), and the walk's t is then the caller's t less t0.  So the walk's
- * own arithmetic is on numbers of the scene's size wherever the origin is.
+ * The ray's origin goes into the frame too, o - c.  One farther than
+ * FAR_MOVE ext from c (ext below) is first moved along the ray to where the
+ * ray enters the scene box, the sum o - c + t0 d taken exactly and rounded
+ * once (prims_along, prims.h), and the walk's t is then the caller's t
+ * less t0.  So the walk's own doubles are of at most FAR_MOVE times the
+ * scene's size wherever the origin is.  A nearer origin (a camera looking
+ * at the scene) is not moved: that costs about as much as the walk of a
+ * primary ray through a few leaves.
  *
  * The margin.  The traversal treats every cell as if it were grown on every
  * side by
@@ -133,11 +136,10 @@
  *     PRIMS_HIT_REL times its longest side (at most 2 ext, prims_frame)
  *     plus PRIMS_HIT_ULPS eps s (the contract of prims.h): ulps is
  *     PRIMS_HIT_ULPS eps;
- *   - the walk's own doubles, all of them of the scene's size: the origin
- *     in the frame (within 3 ext of c, rounded once), each plane crossing
- *     (s - o) / d (three roundings), and the best hit's t less t0 (exact
- *     when t0 is more than half of it, else rounded by 2^-53 of a t inside
- *     the scene): some 10^-15 ext.
+ *   - the walk's own doubles, all of them below FAR_MOVE ext + 2 ext: the
+ *     origin in the frame (rounded once), each plane crossing (s - o) / d
+ *     (three roundings), and the best hit's t less t0 (exact when t0 is
+ *     more than half of it): a few 2^-53 2^20 ext, some 10^-9 ext.
  * So RAY_EPS, four times the float rounding, covers the parts of size ext
  * (3 2^-24 ext and the walk's).  The price is an occasional extra cell for
  * rays passing within delta of a boundary.
@@ -150,6 +152,7 @@
  * best hit so far.  A far origin costs a few cells just behind the hit,
  * not a margin across every cell. */
 #define RAY_EPS 2.5e-7
+#define FAR_MOVE 0x1p20
 
 /* ---- nodes ------------------------------------------------------------ */
 
@@ -232,30 +235,23 @@ typedef struct {
 } kd_todo;
 
 /* The ray from o (in the frame) clipped to the grown scene box, for t in
- * t0..t1 (the slab test of Kay and Kajiya 1986).  0 when it misses the
- * box, and for NaN input.  A flat axis needs no division: the ray is inside
- * that slab for every t or for none. */
-static int clip_ray(const kd_tree *t, const double o[3], const double dir[3],
-                    double t0, double t1, kd_ray *r)
+ * t0..t1 (the slab test of Kay and Kajiya 1986), its direction already set
+ * up (neg, flat, inv).  0 when it misses the box, and for NaN input.  A
+ * flat axis needs no division: the ray is inside that slab for every t or
+ * for none. */
+static int clip_ray(const kd_tree *t, const double o[3], double t0, double t1, kd_ray *r)
 {
     int a;
     for (a = 0; a < 3; a++) {
-        double d = dir[a], lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta;
-        double inv, ta, tb;
-        int neg = signbit(d) != 0;
+        double lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta, inv = r->inv[a], ta, tb;
         r->org[a] = o[a];
-        r->neg[a] = (uint32_t)neg;
-        r->flat[a] = d == 0;
-        if (d == 0) {
-            r->inv[a] = neg ? -HUGE_VAL : HUGE_VAL;
-            r->pad[a] = 0;
+        r->pad[a] = r->flat[a] ? 0 : r->delta * fabs(inv);
+        if (r->flat[a]) {
             if (!(o[a] >= lo && o[a] <= hi)) return 0;
             continue;
         }
-        r->inv[a] = inv = 1.0 / d;
-        r->pad[a] = r->delta * fabs(inv);
-        ta = ((neg ? hi : lo) - o[a]) * inv;
-        tb = ((neg ? lo : hi) - o[a]) * inv;
+        ta = ((r->neg[a] ? hi : lo) - o[a]) * inv;
+        tb = ((r->neg[a] ? lo : hi) - o[a]) * inv;
         if (ta > t0) t0 = ta;
         if (tb < t1) t1 = tb;
     }
@@ -267,33 +263,40 @@ static int clip_ray(const kd_tree *t, const double o[3], const double dir[3],
  * for NaN or infinite input.  Half the rays of a typical view miss the
  * scene box and cost nothing else, so this is one pass over the axes, and
  * a second for an origin from far away, moved to where the first found the
- * ray entering the box (see the frame, above RAY_EPS). */
+ * ray entering the box (see the frame, above RAY_EPS).  The slack's
+ * 1 / max|d| is the least |1/d|: no division of its own. */
 static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, kd_ray *r)
 {
-    double m = t->scale, dmax = 0, ol[3], far = 0;
+    double m = t->scale, least = HUGE_VAL, ol[3], far = 0;
     int a;
     r->skip = skip;
     r->toff = 0;
     for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
     for (a = 0; a < 3; a++) {
-        if (!(fabs(org[a]) <= DBL_MAX) || !isfinite(dir[a])) return 0;
+        double d = dir[a];
+        int neg = signbit(d) != 0;
+        if (!(fabs(org[a]) <= DBL_MAX) || !isfinite(d)) return 0;
         if (fabs(org[a]) > m) m = fabs(org[a]);
-        if (fabs(dir[a]) > dmax) dmax = fabs(dir[a]);
         ol[a] = org[a] - t->c[a];
         if (fabs(ol[a]) > far) far = fabs(ol[a]);
+        r->neg[a] = (uint32_t)neg;
+        r->flat[a] = d == 0;
+        r->inv[a] = d == 0 ? (neg ? -HUGE_VAL : HUGE_VAL) : 1.0 / d;
+        if (fabs(r->inv[a]) < least) least = fabs(r->inv[a]);
     }
-    r->slack = t->ulps * m / dmax;          /* +inf for a zero direction */
+    r->slack = t->ulps * m * least;         /* +inf for a zero direction */
+    if (!(r->slack >= 0)) r->slack = HUGE_VAL;
     tmin -= r->slack, tmax += r->slack;
     /* A far origin in the frame is rounded by a few eps m, across the ray
      * too: the box it is clipped to grows by as much. */
-    r->delta = far > 2 * t->ext ? t->delta + t->ulps * m : t->delta;
-    if (!clip_ray(t, ol, dir, tmin, tmax, r)) return 0;
-    if (!(far > 2 * t->ext)) return 1;
+    r->delta = far > FAR_MOVE * t->ext ? t->delta + t->ulps * m : t->delta;
+    if (!clip_ray(t, ol, tmin, tmax, r)) return 0;
+    if (!(far > FAR_MOVE * t->ext)) return 1;
     r->delta = t->delta;
     r->toff = r->t0;
     for (a = 0; a < 3; a++) ol[a] = prims_along(org[a], t->c[a], r->toff, dir[a]);
-    return clip_ray(t, ol, dir, tmin - r->toff, tmax - r->toff, r);
+    return clip_ray(t, ol, tmin - r->toff, tmax - r->toff, r);
 }
 
 /* The latest t of the walk's (see setup_ray) at which the point of a hit at
