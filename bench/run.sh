@@ -51,7 +51,7 @@
 #           1e13 from it, primary and random rays, Mrays/s as a ratio to
 #           each structure's at the origin (best / median / worst of 5
 #           rounds, structures and places taking turns; every 16th ray
-#           against the loop) (bench/raybench.c far)
+#           against the loop) (bench/raybench.c far; about 50 s)
 #   pov     SPD balls at 512x512, one thread: ./ray against --accel none and
 #           against POV-Ray 3.7; and POV-Ray's other SPD scenes; in rounds,
 #           taking turns
@@ -73,6 +73,7 @@
 # CPU on the 2-core development machine, 11 of wall clock beside other work;
 # 11 and 18 when it renders anew the references it keeps between runs):
 #   BENCH_PARTS="render spd build rays accel anim far pov pt"
+#   BENCH_FAR_RES=256 BENCH_FAR_N=65536   the far section's primary rays a side, and random rays
 #   BENCH_ROUNDS=3           rounds of turns between programs (ours and Embree
 #                            in the accel section, ours and POV-Ray, kd and
 #                            none, the animation's)
