@@ -58,20 +58,46 @@
 #define SAH_DEPTH 64
 #define STACK_SIZE 96
 
-/* The margin.  Boxes are floats rounded outwards, so each holds its
- * primitives' double boxes whole.  The walk then treats every box as grown
- * by delta = BVH_EPS * (largest coordinate of the scene and the ray origin)
- * on every side, for two reasons.  The hit callback's point may lie outside
- * the primitive's box by up to 1e-7 of that coordinate (prims.h).  And the
- * slab test runs in float: b - o rounds by 2^-24 of |b - o| <= 2 * scale,
- * d to float, 1/d and the product by 2^-24 each, so a computed crossing
- * may be off by 4 * 2^-24 * 2 * scale = 4.8e-7 * scale in space.  Together
- * 5.8e-7; 2^-20 = 9.5e-7 covers them with room.  The origin shifted by delta is rounded
- * away from the box (see setup_ray), so its own rounding only adds margin.
+/* The frame.  Boxes are floats relative to a centre c near the middle of
+ * the scene box (prims_frame, prims.h), not to the origin, so that a float
+ * step is 2^-23 of the scene's size wherever the scene lies; they are rounded
+ * outwards, so each holds its primitives' double boxes whole (give or take
+ * the rounding of x - c in double, 2^-53 ext).
+ *
+ * The margin.  The walk treats every box as grown on every side by
+ *     delta = BVH_EPS * ext + ulps * s,
+ * ext the largest |coordinate| of the scene box in the frame, s the largest
+ * in the caller's.  The hit callback's point may lie outside its
+ * primitive's box by PRIMS_HIT_REL of the box's longest side (at most
+ * 2 ext) plus PRIMS_HIT_ULPS eps s (the contract of prims.h; ulps is
+ * PRIMS_HIT_ULPS eps).  The slab test runs in float in the frame, from an
+ * origin o at most D from the frame's centre: b - o rounds by 2^-24 of
+ * |b - o| <= D + ext, d to float, 1/d and the product by 2^-24 each, so a
+ * computed crossing may be off by 4 * 2^-24 (D + ext) in space.  For
+ * D <= 2 ext that is 7.2e-7 ext, with the callback's 2 * 2^-24 ext
+ * 8.3e-7 ext, which BVH_EPS = 2^-20 = 9.5e-7 covers; a farther origin (a
+ * camera looking at the scene) adds BVH_EPS D / 2 to the margin for the
+ * rest, and one farther than FAR_MOVE ext is moved along the ray to where
+ * it enters the grown scene box (setup_ray), and is within 2 ext again.  The origin shifted by delta is
+ * rounded away from the box (see setup_ray), so its own rounding only adds
+ * margin.  The origin moved along the ray, o - c + t0 d, is summed exactly
+ * and rounded once (prims_along, prims.h), so it lies on the ray to within
+ * a rounding of a number of the scene's size; the walk's t is then the
+ * caller's t less t0, taken in double (exact when t0 is more than half of it) before
+ * it is rounded up to a float.
+ *
+ * The slack.  The contract also lets the callback's t err along the ray by
+ * ulps m / max|d|, m the larger of s and the origin's largest |coordinate|
+ * (a ray from 10^13 away has t of 10^13, rounded by 10^-3): the walk takes
+ * the ray from tmin - slack, and leaves a box out only when the ray enters
+ * it more than slack beyond the best hit so far.  So a far origin costs a
+ * box now and then just behind the hit, not a margin across every box.
+ *
  * The float test is valid while the numbers stay well inside the float
  * range (FAST_MAX below); other rays are answered by testing every
  * primitive. */
 #define BVH_EPS (1.0 / 1048576.0)
+#define FAR_MOVE 64
 #define FAST_MAX 0x1p60
 #define FAST_MIN 0x1p-60
 
@@ -112,7 +138,13 @@ struct bvh {
     long nnodes, nprims;
     void *block;       /* the allocation behind nodes and prims */
     size_t bytes;
-    double scale;      /* largest |coordinate| of the root's boxes */
+    double c[3];       /* the frame: boxes are relative to c (see BVH_EPS) */
+    double lo[3], hi[3];  /* the root's boxes together, in the frame */
+    double ext;        /* largest |coordinate| of the root's boxes in the frame */
+    double scale;      /* largest |coordinate| of the root's boxes in the caller's coordinates */
+    double ulps;       /* PRIMS_HIT_ULPS eps (see BVH_EPS) */
+    double delta;      /* the margin (see BVH_EPS) */
+    double slack_ulps; /* ulps, and 2^-21 more for a float 1/d (setup_ray) */
     bvh_info info;
 };
 
@@ -135,7 +167,9 @@ static float up(double x)
 
 /* ---- traversal ---------------------------------------------------------- */
 
-/* The ray as the slab test needs it.  For each axis, neg picks the box
+/* The ray as the slab test needs it, in the frame, its origin moved by
+ * toff along it when it started far away (see setup_ray): the walk's t is
+ * the caller's t - toff.  For each axis, neg picks the box
  * corner the ray meets first (from the sign bit, so -0 counts as negative
  * like its 1/d = -inf).  on and of are the origin moved by delta: the near
  * plane of a box grown by delta is at b - delta (b + delta for neg), and
@@ -147,6 +181,8 @@ typedef struct {
     float on[3], of[3], inv[3];
     int neg[3];
     float tmin;
+    double toff;       /* how far along the ray the origin was moved */
+    double slack;      /* how far along the ray a hit's t may err (see BVH_EPS) */
     int skip;
 } bvh_ray;
 
@@ -158,31 +194,73 @@ typedef struct {
 } bvh_todo;
 
 /* The ray set up for the float slab test: 1, or 0 when its numbers leave
- * the test's range (see BVH_EPS), or -1 for NaN or infinite input. */
+ * the test's range (see BVH_EPS), or -1 when it can hit nothing: NaN or
+ * infinite input, or a ray from far away that misses the scene box.  The
+ * origin goes into the frame; one farther than FAR_MOVE ext from its
+ * centre is moved along the ray to where the ray enters the grown scene
+ * box (the slab test of Kay and Kajiya 1986, in double), so that the float
+ * test sees numbers of the scene's size: from 1e13 away a float would hold
+ * the origin only to 1e6. */
 static int setup_ray(const bvh *t, const double org[3], const double dir[3],
-                     int skip, double tmin, bvh_ray *r)
+                     int skip, double tmin, double tmax, bvh_ray *r)
 {
-    double scale = t->scale, dmax = 0, delta;
+    double scale = t->scale, dmax = 0, delta = t->delta, o[3], far = 0;
+    float least = HUGE_VALF;
     int a;
     for (a = 0; a < 3; a++) {
-        double o = fabs(org[a]), d = fabs(dir[a]);
-        if (!(o <= DBL_MAX && d <= DBL_MAX)) return -1;
-        if (o > scale) scale = o;
+        double m = fabs(org[a]), d = fabs(dir[a]);
+        if (!(m <= DBL_MAX && d <= DBL_MAX)) return -1;
+        if (m > scale) scale = m;
         if (d > dmax) dmax = d;
+        o[a] = org[a] - t->c[a];
+        if (fabs(o[a]) > far) far = fabs(o[a]);
+        r->inv[a] = 1.0f / (float)dir[a];    /* +-inf for +-0 and tiny d */
+        if (fabsf(r->inv[a]) < least) least = fabsf(r->inv[a]);
     }
     r->skip = skip;
     if (!(scale <= FAST_MAX && scale >= FAST_MIN && dmax <= FAST_MAX && dmax >= FAST_MIN))
         return 0;
-    delta = BVH_EPS * scale;
+    /* 1 / max|d| is the least |1/d|, rounded twice to float: slack_ulps
+     * allows for that (no division of its own) */
+    r->slack = t->slack_ulps * scale * least;
+    r->toff = 0;
+    tmin -= r->slack;
+    if (far > 2 * t->ext && !(far > FAR_MOVE * t->ext))   /* a camera looking on */
+        delta += 0.5 * BVH_EPS * far;       /* see BVH_EPS */
+    else if (far > FAR_MOVE * t->ext) {
+        double t0 = tmin, t1 = tmax + r->slack;
+        double grow = delta + t->ulps * scale;   /* o is rounded by a few eps m */
+        for (a = 0; a < 3; a++) {
+            double lo = t->lo[a] - grow - o[a], hi = t->hi[a] + grow - o[a], inv, ta, tb;
+            if (dir[a] == 0) {
+                if (!(lo <= 0 && hi >= 0)) return -1;
+                continue;
+            }
+            inv = 1 / dir[a];
+            ta = lo * inv, tb = hi * inv;
+            if (ta > tb) inv = ta, ta = tb, tb = inv;
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+        }
+        if (!(t0 <= t1)) return -1;
+        r->toff = t0;
+        for (a = 0; a < 3; a++) o[a] = prims_along(org[a], t->c[a], t0, dir[a]);
+    }
     for (a = 0; a < 3; a++) {
         int neg = signbit(dir[a]) != 0;
         r->neg[a] = neg;
-        r->on[a] = neg ? down(org[a] - delta) : up(org[a] + delta);
-        r->of[a] = neg ? up(org[a] + delta) : down(org[a] - delta);
-        r->inv[a] = 1.0f / (float)dir[a];    /* +-inf for +-0 and tiny d */
+        r->on[a] = neg ? down(o[a] - delta) : up(o[a] + delta);
+        r->of[a] = neg ? up(o[a] + delta) : down(o[a] - delta);
     }
-    r->tmin = down(tmin);
+    r->tmin = down(tmin - r->toff);
     return 1;
+}
+
+/* The latest t of the walk's (see setup_ray), rounded up to a float, at
+ * which the point of a hit at the caller's t may lie. */
+static float walk_t(const bvh_ray *r, double t)
+{
+    return up(t - r->toff + r->slack);
 }
 
 /* Intersect(ray, object) for each primitive of a leaf.  Nearest: keep the
@@ -262,9 +340,9 @@ static int bvh_intersect(const bvh *t, const prims *p, const bvh_ray *r,
     if (node.count)
         return test_leaf(t, node.index, node.count, p, r, ray, tmin, any, best_t, best,
                          &c->tests);
-    n = children(&t->nodes[node.index], r, up(*best_t), child);
+    n = children(&t->nodes[node.index], r, walk_t(r, *best_t), child);
     for (k = 0; k < n; k++) {
-        if (k > 0 && !(child[k].entry <= up(*best_t))) break;
+        if (k > 0 && !(child[k].entry <= walk_t(r, *best_t))) break;
         best = bvh_intersect(t, p, r, ray, tmin, any, child[k], best_t, best, c);
         if (any && best >= 0) break;
     }
@@ -279,7 +357,7 @@ static int walk(const bvh *t, const prims *p, const bvh_ray *r, void *ray,
                 double tmin, int any, double *best_t, prim_counters *c)
 {
     bvh_todo stack[3 * STACK_SIZE], node, child[4];
-    float tmax = up(*best_t);
+    float tmax = walk_t(r, *best_t);
     unsigned long long steps = 0, tests = 0;
     int n = 0, best = -1;
     node.index = 0, node.count = 0;
@@ -298,7 +376,7 @@ static int walk(const bvh *t, const prims *p, const bvh_ray *r, void *ray,
                              &tests);
             if (best != was) {
                 if (any) break;
-                tmax = up(*best_t);
+                tmax = walk_t(r, *best_t);
             }
         }
         while (n > 0 && !(stack[n - 1].entry <= tmax)) n--;
@@ -318,7 +396,7 @@ static int query(const bvh *t, const prims *p, const double org[3],
     int a;
     if (c) c->rays++;
     if (!t || t->nnodes == 0 || !(tmin <= *best_t)) return -1;
-    a = setup_ray(t, org, dir, skip, tmin, &r);
+    a = setup_ray(t, org, dir, skip, tmin, *best_t, &r);
     if (a < 0) return -1;
     if (a == 0) {
         /* out of the float test's range (see BVH_EPS): every primitive */
@@ -396,17 +474,18 @@ static double box_area(const bvh_box *b)
     return 2 * (dx * dy + dy * dz + dz * dx);
 }
 
-/* Primitive i's box from the callback, rounded outwards to floats: it holds
- * the double box whole.  0 for NaN or lo > hi. */
-static int prim_box(const prims *p, int i, bvh_box *b)
+/* Primitive i's box from the callback, in the frame centred on c, rounded
+ * outwards to floats: it holds the double box whole.  0 for NaN or
+ * lo > hi. */
+static int prim_box(const prims *p, int i, const double c[3], bvh_box *b)
 {
     double lo[3], hi[3];
     int a;
     p->bounds(p->user, i, lo, hi);
     for (a = 0; a < 3; a++) {
         if (!(lo[a] <= hi[a])) return 0;
-        b->lo[a] = down(lo[a]);
-        b->hi[a] = up(hi[a]);
+        b->lo[a] = down(lo[a] - c[a]);
+        b->hi[a] = up(hi[a] - c[a]);
     }
     b->lo[3] = b->lo[2], b->hi[3] = b->hi[2];
     return 1;
@@ -442,6 +521,7 @@ typedef struct {
 typedef struct {
     const prims *p;
     int method;
+    double c[3];          /* the frame (see BVH_EPS) */
     bvh_ref *ref;
     bvh_node *nodes;
     long nnodes;
@@ -783,17 +863,25 @@ static double tree_cost4(const bvh *t)
     return sum;
 }
 
+/* The scene box (the root's lanes together) in the frame, its largest
+ * coordinate there and in the caller's coordinates, and the margin. */
 static void set_scale(bvh *t)
 {
-    int a, s, k;
-    t->scale = 0;
+    int a, k;
+    bvh_box root, box;
+    t->scale = t->ext = t->delta = 0;
+    for (a = 0; a < 3; a++) t->lo[a] = t->hi[a] = 0;
     if (t->nnodes == 0) return;
+    box_empty(&root);
     for (k = 0; k < 4; k++)
-        for (s = 0; s < 2; s++)
-            for (a = 0; a < 3; a++) {
-                float x = t->nodes[0].box[s][a][k];
-                if (!lane_empty(&t->nodes[0], k) && fabs(x) > t->scale) t->scale = fabs(x);
-            }
+        if (!lane_empty(&t->nodes[0], k)) lane_to_box(&t->nodes[0], k, &box), box_grow(&root, &box);
+    for (a = 0; a < 3; a++) {
+        if (!(root.lo[a] <= root.hi[a])) return;   /* nothing in the tree */
+        t->lo[a] = root.lo[a], t->hi[a] = root.hi[a];
+        t->ext = fmax(t->ext, fmax(fabs(t->lo[a]), fabs(t->hi[a])));
+        t->scale = fmax(t->scale, fmax(fabs(t->c[a] + t->lo[a]), fabs(t->c[a] + t->hi[a])));
+    }
+    t->delta = BVH_EPS * t->ext + t->ulps * t->scale;
 }
 
 /* The tree in one block, the nodes aligned to 64 bytes. */
@@ -823,6 +911,9 @@ static bvh *finish(bvh_builder *b, const int *ids, long nprims)
     t->bytes = (size_t)used * sizeof(bvh_node4) + (size_t)nprims * sizeof(int);
     if (nprims) memcpy(t->nodes + used, ids, (size_t)nprims * sizeof(int));
     t->prims = (int *)(t->nodes + used);
+    memcpy(t->c, b->c, sizeof t->c);
+    t->ulps = PRIMS_HIT_ULPS * (b->p->eps > 0 ? b->p->eps : DBL_EPSILON);
+    t->slack_ulps = t->ulps * (1 + 0x1p-21);
     set_scale(t);
     t->info.nodes = used;
     t->info.leaves = b->leaves;
@@ -842,7 +933,7 @@ static long gather(bvh_builder *b, int n)
     int i;
     for (i = 0; i < n; i++) {
         bvh_box box;
-        if (!prim_box(b->p, i, &box)) continue;
+        if (!prim_box(b->p, i, b->c, &box)) continue;
         memcpy(b->ref[m].lo, box.lo, sizeof b->ref[m].lo);
         memcpy(b->ref[m].hi, box.hi, sizeof b->ref[m].hi);
         b->ref[m].id = i, b->ref[m].pad = 0;
@@ -865,6 +956,8 @@ bvh *bvh_build(int n, const prims *p, int method)
     b.nodes = calloc(2 * (size_t)n + 2, sizeof *b.nodes);
     ids = malloc(((size_t)n + 1) * sizeof *ids);
     if (b.ref && b.nodes && ids) {
+        double lo[3], hi[3];
+        prims_frame(p, n, lo, hi, b.c);
         m = gather(&b, n);
         if (m > 0) {
             bvh_box box, cbox;
@@ -895,7 +988,7 @@ void bvh_refit(bvh *t, const prims *p)
             if (lane_empty(nd, k)) continue;
             box_empty(&box);
             for (m = 0; m < nd->count[k]; m++)
-                if (prim_box(p, t->prims[nd->index[k] + m], &c)) box_grow(&box, &c);
+                if (prim_box(p, t->prims[nd->index[k] + m], t->c, &c)) box_grow(&box, &c);
             for (j = 0; nd->count[k] == 0 && j < 4; j++) {
                 lane_to_box(&t->nodes[nd->index[k]], j, &c);
                 box_grow(&box, &c);
@@ -928,7 +1021,7 @@ long bvh_planes(const bvh *t, int *axis, double *pos, long max)
         for (k = 0; k < 4; k++)
             for (s = 0; s < 2 && !lane_empty(&t->nodes[i], k); s++)
                 for (a = 0; a < 3; a++) {
-                    if (n < max) axis[n] = a, pos[n] = t->nodes[i].box[s][a][k];
+                    if (n < max) axis[n] = a, pos[n] = t->c[a] + t->nodes[i].box[s][a][k];
                     n++;
                 }
     return n;

@@ -90,7 +90,8 @@ void bvh_describe(const bvh *b, bvh_info *info);
 void bvh_free(bvh *b);
 
 /* For tests: the axis and position of each face of every node's box, six
- * per node, in node order; writes at most max pairs and returns how many
- * there are. */
+ * per node, in node order, in the caller's coordinates (the nearest double
+ * to the float face, which the tree keeps relative to a centre of its
+ * own); writes at most max pairs and returns how many there are. */
 long bvh_planes(const bvh *b, int *axis, double *pos, long max);
 #endif

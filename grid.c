@@ -10,11 +10,11 @@
  * scene's box allows (an axis along which the box is flat gets one cell).
  *
  * Exactness.  A plain DDA visits the cells the ray passes through.  A hit
- * point may lie a little outside its primitive's box (prims.h allows 1e-7
- * of the largest coordinate), and so in a cell that does not list it; like
- * the kd-tree (kdtree.c, RAY_EPS), the walk therefore treats every cell as
- * grown by delta = RAY_EPS * (largest coordinate of the scene and the ray
- * origin).  It visits every cell whose grown box the ray passes through, in
+ * point may lie a little outside its primitive's box (the contract of
+ * prims.h), and so in a cell that does not list it; like the kd-tree
+ * (kdtree.c, RAY_EPS), the walk therefore treats every cell as grown by a
+ * margin delta (see RAY_EPS below).  It visits every cell whose grown box
+ * the ray passes through, in
  * the order the ray enters them: per axis it keeps the range of cell
  * indices that a cube of half-side delta around the ray's point overlaps.
  * The leading end of a range moving on is Amanatides & Woo's step (it
@@ -43,10 +43,32 @@
  * are made coarser, halving each side until they do not. */
 #define MAX_REFS 16
 
-/* The margin, as in kdtree.c: four times the float rounding that the
- * contract of prims.h allows (1e-7), so the DDA's own double rounding
- * (about 1e-16 of the same coordinates) is far inside it. */
+/* The margin:
+ *     delta = RAY_EPS * ext + (WALK_ULPS DBL_EPSILON + ulps) * s,
+ * ext half the longest side of the scene box, s the largest |coordinate| of
+ * the scene box.  The hit callback's point may lie outside its primitive's
+ * box by PRIMS_HIT_REL of the box's longest side (at most 2 ext) plus
+ * PRIMS_HIT_ULPS eps s (the contract of prims.h): ulps = PRIMS_HIT_ULPS
+ * eps, and the first is inside RAY_EPS ext, as in kdtree.c.  The grid has
+ * no floats and keeps the caller's coordinates: its faces lo + i w, the
+ * cells of a point, floor((x - lo) / w), and the DDA's crossings
+ * (face - o) / d are doubles, a few roundings each of numbers below 2s +
+ * 2 ext (a point and its cell may disagree by as much), which WALK_ULPS
+ * DBL_EPSILON s covers.  An origin at D from the box's middle adds a few
+ * 2^-53 D, inside RAY_EPS ext while D is below FAR_MOVE ext: a farther one
+ * is first moved along the ray to where the ray enters the box, the sum
+ * o + t0 d taken exactly and rounded once (prims_along, prims.h), and the
+ * walk's t is then the caller's t less t0.
+ *
+ * The slack.  The contract also lets the callback's t err along the ray by
+ * ulps m / max|d|, m the larger of s and the origin's largest |coordinate|
+ * (from 10^13 away, t is rounded by 10^-3): the walk takes the ray from
+ * tmin - slack to tmax + slack and stops only before a cell it enters more
+ * than slack beyond the best hit.  A far origin costs a cell now and then
+ * just behind the hit, not a margin across every cell. */
 #define RAY_EPS 2.5e-7
+#define WALK_ULPS 8
+#define FAR_MOVE 0x1p20
 
 /* Each ray keeps the last primitive tested in each of MAILBOX slots chosen
  * by the primitive's number (Amanatides & Woo 1987): an object in several
@@ -64,6 +86,10 @@ struct grid {
     int res[3];
     double hi[3];                  /* the scene box's far corner */
     double scale;                  /* largest |coordinate| of the scene box */
+    double ext;                    /* half the longest side of the scene box */
+    double mid[3];                 /* the scene box's middle */
+    double delta;                  /* the margin (see RAY_EPS) */
+    double ulps;                   /* PRIMS_HIT_ULPS eps: the slack's factor of m */
     double narrow;                 /* the narrowest cell side (of axes cut in two or more) */
     uint32_t *start;               /* cell c lists list[start[c] .. start[c+1]) */
     int *list;
@@ -80,6 +106,8 @@ typedef struct {
     double o[3], d[3], inv[3];
     int flat[3];
     double delta;
+    double toff;            /* how far along the ray o was moved: the walk's t is the caller's less toff */
+    double slack;           /* how far along the ray a hit's t may err (see RAY_EPS) */
     double t0, t1;          /* the ray inside the grid's grown box */
     int lo[3], hi[3];       /* cells overlapped by the grown point, per axis */
     int skip;
@@ -98,36 +126,58 @@ static double face(const grid *g, int a, int i)
 }
 
 /* Clip the ray to the grid's box grown by delta (the slab test); 0 when it
- * misses it, or when its numbers are out of range for the walk. */
+ * misses it, or when its numbers are out of range for the walk.  An origin
+ * from far away is moved first (see RAY_EPS), to where the ray enters the
+ * box by the same test on the unmoved origin. */
 static int setup_ray(const grid *g, const double org[3], const double dir[3],
                      int skip, double tmin, double tmax, grid_ray *r)
 {
-    double scale = g->scale, dmax = 0, t0 = tmin, t1 = tmax;
-    int a;
+    double scale = g->scale, dmax = 0, t0, t1, far = 0, o[3], least = HUGE_VAL;
+    int a, pass, move;
     for (a = 0; a < 3; a++) {
         if (fabs(org[a]) > scale) scale = fabs(org[a]);
         if (fabs(dir[a]) > dmax) dmax = fabs(dir[a]);
+        if (fabs(org[a] - g->mid[a]) > far) far = fabs(org[a] - g->mid[a]);
+        o[a] = org[a];
     }
-    r->delta = RAY_EPS * scale;
+    for (a = 0; a < 3; a++) {
+        r->d[a] = dir[a];
+        r->flat[a] = !(fabs(dir[a]) > FLAT * dmax);
+        r->inv[a] = r->flat[a] ? 0 : 1 / dir[a];
+        if (!r->flat[a] && fabs(r->inv[a]) < least) least = fabs(r->inv[a]);
+    }
+    r->slack = g->ulps * scale * least;     /* 1 / max|d|, no division of its own */
+    if (!(r->slack >= 0)) r->slack = HUGE_VAL;
+    tmin -= r->slack, tmax += r->slack;
+    t0 = tmin, t1 = tmax;
+    r->toff = 0;
     r->skip = skip;
     for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
-    for (a = 0; a < 3; a++) {
-        double lo = g->lo[a] - r->delta, hi = g->hi[a] + r->delta, ta, tb;
-        r->o[a] = org[a], r->d[a] = dir[a];
-        r->flat[a] = !(fabs(dir[a]) > FLAT * dmax);
-        if (r->flat[a]) {
-            r->inv[a] = 0;
-            if (!(org[a] >= lo && org[a] <= hi)) return 0;
-            continue;
+    move = far > FAR_MOVE * g->ext;
+    r->delta = g->delta + (move ? g->ulps * scale : 0);   /* a far o's rounding, across the ray too */
+    for (pass = move; pass >= 0; pass--) {
+        if (pass == 0 && move) {            /* from far away: move the origin to t0 */
+            r->delta = g->delta;
+            for (a = 0; a < 3; a++) o[a] = prims_along(org[a], 0, r->toff, dir[a]);
+            t0 = tmin - r->toff, t1 = tmax - r->toff;
         }
-        r->inv[a] = 1 / dir[a];
-        ta = (lo - org[a]) * r->inv[a], tb = (hi - org[a]) * r->inv[a];
-        if (ta > tb) { double s = ta; ta = tb; tb = s; }
-        if (ta > t0) t0 = ta;
-        if (tb < t1) t1 = tb;
+        for (a = 0; a < 3; a++) {
+            double lo = g->lo[a] - r->delta, hi = g->hi[a] + r->delta, ta, tb;
+            r->o[a] = o[a];
+            if (r->flat[a]) {
+                if (!(o[a] >= lo && o[a] <= hi)) return 0;
+                continue;
+            }
+            ta = (lo - o[a]) * r->inv[a], tb = (hi - o[a]) * r->inv[a];
+            if (ta > tb) { double s = ta; ta = tb; tb = s; }
+            if (ta > t0) t0 = ta;
+            if (tb < t1) t1 = tb;
+        }
+        if (!(t0 <= t1)) return 0;
+        if (pass == 1) r->toff = t0;
     }
     r->t0 = t0, r->t1 = t1;
-    return t0 <= t1;
+    return 1;
 }
 
 /* The time the range of axis a next gains a cell (lead) or loses one
@@ -218,7 +268,7 @@ static int walk(const grid *g, const prims *p, grid_ray *r, void *ray, double tm
             lag[al] = lag_time(g, r, al);
             continue;
         }
-        if (!(lead[as] <= r->t1) || *best_t < lead[as]) break;
+        if (!(lead[as] <= r->t1) || *best_t - r->toff + r->slack < lead[as]) break;
         if (r->d[as] > 0) r->hi[as]++;     /* step: a new slab of cells */
         else r->lo[as]--;
         memcpy(lo, r->lo, sizeof lo), memcpy(hi, r->hi, sizeof hi);
@@ -248,8 +298,9 @@ static int query(const grid *g, const prims *p, const double org[3], const doubl
     if (!(tmin <= *best_t)) return -1;
     if (!setup_ray(g, org, dir, skip, tmin, *best_t, &r)) return -1;
     /* Every primitive, for rays out of range, and where the margin is wider
-     * than half a cell (a scene far from the origin, or a far ray origin):
-     * the walk would visit blocks of cells and gain nothing. */
+     * than half a cell (cells some 10^14 times smaller than the scene's
+     * distance from the origin): the walk would visit blocks of cells and
+     * gain nothing. */
     if (!(s <= FAST_MAX && dmax <= FAST_MAX && dmax >= FAST_MIN) || 2 * r.delta > g->narrow)
         return test_list(g->all, g->nall, p, &r, ray, tmin, any, best_t, -1, c);
     return walk(g, p, &r, ray, tmin, any, best_t, c);
@@ -401,11 +452,15 @@ static long scene_box(grid *g, int n, const prims *p, int *all)
         }
         all[m++] = i;
     }
-    g->scale = 0;
+    g->scale = g->ext = 0;
     for (a = 0; a < 3; a++) {
         if (fabs(g->lo[a]) > g->scale) g->scale = fabs(g->lo[a]);
         if (fabs(g->hi[a]) > g->scale) g->scale = fabs(g->hi[a]);
+        if (0.5 * (g->hi[a] - g->lo[a]) > g->ext) g->ext = 0.5 * (g->hi[a] - g->lo[a]);
+        g->mid[a] = 0.5 * g->lo[a] + 0.5 * g->hi[a];
     }
+    g->ulps = PRIMS_HIT_ULPS * (p->eps > 0 ? p->eps : DBL_EPSILON);
+    g->delta = RAY_EPS * g->ext + (WALK_ULPS * DBL_EPSILON + g->ulps) * g->scale;
     return m;
 }
 

@@ -105,22 +105,54 @@
 #define BUDGET 16
 #endif
 
-/* The traversal treats every cell as if it were grown by a margin
- * delta = RAY_EPS * (largest coordinate of the scene box and the ray origin)
- * on every side, and visits every cell whose grown box the ray passes
- * through.  Two kinds of rounding need it.  The tree's planes and boxes are
- * floats rounded to nearest (see kd_box), so a primitive may reach past the
- * cells that list it by half a float step, at most 2^-24 = 6e-8 of the
- * largest coordinate.  And plane crossings t = (s - o) / d carry rounding
- * errors, as do the hit callback's t and its inside tests.  Without the
- * margin a hit lying on a cell boundary could be judged to lie only in the
- * cell that does not list its primitive.  With 2.5e-7, four times the float
- * rounding, the tree returns exactly what brute force returns as long as
- * the callback's hit points lie within 1e-7 of the largest coordinate of
- * the primitive's box: a million times the rounding of one double
- * operation.  The price is an occasional extra cell for rays passing within
- * delta of a boundary. */
+/* The frame.  The tree keeps its planes and boxes as floats relative to a
+ * centre c near the middle of the scene box (prims_frame, prims.h), not to
+ * the origin: a float step is then 2^-23 of the scene's size wherever the
+ * scene lies.  In the caller's coordinates a scene 1e8 from the origin
+ * would have float steps of 8 units, and a unit-sized scene would collapse
+ * into a few of them.
+ *
+ * The ray's origin goes into the frame too, o - c.  One farther than
+ * FAR_MOVE ext from c (ext below) is first moved along the ray to where the
+ * ray enters the scene box, the sum o - c + t0 d taken exactly and rounded
+ * once (prims_along, prims.h), and the walk's t is then the caller's t
+ * less t0.  So the walk's own doubles are of at most FAR_MOVE times the
+ * scene's size wherever the origin is.  A nearer origin (a camera looking
+ * at the scene) is not moved: that costs about as much as the walk of a
+ * primary ray through a few leaves.
+ *
+ * The margin.  The traversal treats every cell as if it were grown on every
+ * side by
+ *     delta = RAY_EPS * ext + ulps * s,
+ * ext the largest |coordinate| of the scene box in the tree's frame, s the
+ * largest in the caller's, and visits every cell whose grown box the ray
+ * passes through.  Without it a hit lying on a cell boundary could be
+ * judged to lie only in the cell that does not list its primitive.  It
+ * covers:
+ *   - the boxes and planes, floats rounded to nearest (see kd_box): a
+ *     primitive may reach past the cells that list it by half a float
+ *     step, at most 2^-24 ext;
+ *   - the hit callback's point, outside the primitive's box by up to
+ *     PRIMS_HIT_REL times its longest side (at most 2 ext, prims_frame)
+ *     plus PRIMS_HIT_ULPS eps s (the contract of prims.h): ulps is
+ *     PRIMS_HIT_ULPS eps;
+ *   - the walk's own doubles, all of them below FAR_MOVE ext + 2 ext: the
+ *     origin in the frame (rounded once), each plane crossing (s - o) / d
+ *     (three roundings), and the best hit's t less t0 (exact when t0 is
+ *     more than half of it): a few 2^-53 2^20 ext, some 10^-9 ext.
+ * So RAY_EPS, four times the float rounding, covers the parts of size ext
+ * (3 2^-24 ext and the walk's).  The price is an occasional extra cell for
+ * rays passing within delta of a boundary.
+ *
+ * The slack.  The contract lets the callback's t err along the ray by
+ * ulps m / max|d| (m the larger of s and the origin's largest |coordinate|):
+ * a ray from 10^13 away has t of 10^13, rounded by 10^-3.  So the walk
+ * takes the ray from tmin - slack to tmax + slack, slack that much, and
+ * leaves a cell out only when the ray enters it more than slack beyond the
+ * best hit so far.  A far origin costs a few cells just behind the hit,
+ * not a margin across every cell. */
 #define RAY_EPS 2.5e-7
+#define FAR_MOVE 0x1p20
 
 /* ---- nodes ------------------------------------------------------------ */
 
@@ -150,8 +182,12 @@ static uint32_t node_index(const kd_node *n) { return n->bits >> 2; }
 struct kd_tree {
     kd_node *nodes;  /* nodes[0] is the root; one block with `prims` */
     int *prims;      /* the leaves' lists of primitive numbers */
-    double lo[3], hi[3];  /* scene box: the union of the primitives' boxes */
-    double scale;    /* largest |coordinate| of the scene box */
+    double c[3];     /* the frame: planes and boxes are relative to c */
+    double lo[3], hi[3];  /* scene box, the union of the primitives' boxes, in the frame */
+    double ext;      /* largest |coordinate| of the scene box in the frame */
+    double scale;    /* largest |coordinate| of the scene box in the caller's coordinates */
+    double ulps;     /* PRIMS_HIT_ULPS eps (see RAY_EPS) */
+    double delta;    /* the margin (see RAY_EPS) */
     size_t bytes;
     kd_info info;
 };
@@ -177,12 +213,16 @@ struct kd_tree {
  * delta (see RAY_EPS) in units of t along axis a.  A denormal component can
  * make inv and pad infinite and the plane crossings NaN; every comparison
  * below is written so that NaN means "visit", which is always safe.  The
- * origin is copied, not pointed to: the walk reads it at every step. */
+ * origin is in the tree's frame, moved along the ray by toff when it came
+ * from far away (see RAY_EPS): every t of the walk's is the caller's less
+ * toff. */
 typedef struct {
     double org[3], inv[3], pad[3];
     uint32_t neg[3];
     int flat[3];
     double delta;
+    double toff;    /* how far along the ray the origin was moved */
+    double slack;   /* how far along the ray a hit's t may err (see RAY_EPS) */
     double t0, t1;  /* the part of the ray inside the (grown) scene box */
     int skip;       /* the caller's primitive never to test, or -1 */
     int mail[MAILBOX];
@@ -194,46 +234,76 @@ typedef struct {
     double t0, t1;
 } kd_todo;
 
-/* Set up the ray and clip it to the grown scene box (the slab test of Kay
- * and Kajiya 1986).  0 when it misses the box, and for NaN or infinite
- * input.  A flat axis needs no division: the ray is inside that slab for
- * every t or for none.  Half the rays of a typical view miss the scene box
- * and cost nothing else, so this is kept to one pass over the axes. */
-static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
-                     int skip, double tmin, double tmax, kd_ray *r)
+/* The ray from o (in the frame) clipped to the grown scene box, for t in
+ * t0..t1 (the slab test of Kay and Kajiya 1986), its direction already set
+ * up (neg, flat, inv).  0 when it misses the box, and for NaN input.  A
+ * flat axis needs no division: the ray is inside that slab for every t or
+ * for none. */
+static int clip_ray(const kd_tree *t, const double o[3], double t0, double t1, kd_ray *r)
 {
-    double scale = t->scale, t0 = tmin, t1 = tmax;
     int a;
-    r->skip = skip;
-    for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
     for (a = 0; a < 3; a++) {
-        double m = fabs(org[a]);
-        if (!(m <= DBL_MAX) || !isfinite(dir[a])) return 0;
-        if (m > scale) scale = m;
-    }
-    r->delta = RAY_EPS * scale;
-    for (a = 0; a < 3; a++) {
-        double o = org[a], d = dir[a], lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta;
-        double inv, ta, tb;
-        int neg = signbit(d) != 0;
-        r->org[a] = o;
-        r->neg[a] = (uint32_t)neg;
-        r->flat[a] = d == 0;
-        if (d == 0) {
-            r->inv[a] = neg ? -HUGE_VAL : HUGE_VAL;
-            r->pad[a] = 0;
-            if (!(o >= lo && o <= hi)) return 0;
+        double lo = t->lo[a] - r->delta, hi = t->hi[a] + r->delta, inv = r->inv[a], ta, tb;
+        r->org[a] = o[a];
+        r->pad[a] = r->flat[a] ? 0 : r->delta * fabs(inv);
+        if (r->flat[a]) {
+            if (!(o[a] >= lo && o[a] <= hi)) return 0;
             continue;
         }
-        r->inv[a] = inv = 1.0 / d;
-        r->pad[a] = r->delta * fabs(inv);
-        ta = ((neg ? hi : lo) - o) * inv;
-        tb = ((neg ? lo : hi) - o) * inv;
+        ta = ((r->neg[a] ? hi : lo) - o[a]) * inv;
+        tb = ((r->neg[a] ? lo : hi) - o[a]) * inv;
         if (ta > t0) t0 = ta;
         if (tb < t1) t1 = tb;
     }
     r->t0 = t0, r->t1 = t1;
     return t0 <= t1;  /* false for NaN in tmin or tmax */
+}
+
+/* Set up the ray and clip it to the grown scene box; 0 when it misses, and
+ * for NaN or infinite input.  Half the rays of a typical view miss the
+ * scene box and cost nothing else, so this is one pass over the axes, and
+ * a second for an origin from far away, moved to where the first found the
+ * ray entering the box (see the frame, above RAY_EPS).  The slack's
+ * 1 / max|d| is the least |1/d|: no division of its own. */
+static int setup_ray(const kd_tree *t, const double org[3], const double dir[3],
+                     int skip, double tmin, double tmax, kd_ray *r)
+{
+    double m = t->scale, least = HUGE_VAL, ol[3], far = 0;
+    int a;
+    r->skip = skip;
+    r->toff = 0;
+    for (a = 0; a < MAILBOX; a++) r->mail[a] = -1;
+    for (a = 0; a < 3; a++) {
+        double d = dir[a];
+        int neg = signbit(d) != 0;
+        if (!(fabs(org[a]) <= DBL_MAX) || !isfinite(d)) return 0;
+        if (fabs(org[a]) > m) m = fabs(org[a]);
+        ol[a] = org[a] - t->c[a];
+        if (fabs(ol[a]) > far) far = fabs(ol[a]);
+        r->neg[a] = (uint32_t)neg;
+        r->flat[a] = d == 0;
+        r->inv[a] = d == 0 ? (neg ? -HUGE_VAL : HUGE_VAL) : 1.0 / d;
+        if (fabs(r->inv[a]) < least) least = fabs(r->inv[a]);
+    }
+    r->slack = t->ulps * m * least;         /* +inf for a zero direction */
+    if (!(r->slack >= 0)) r->slack = HUGE_VAL;
+    tmin -= r->slack, tmax += r->slack;
+    /* A far origin in the frame is rounded by a few eps m, across the ray
+     * too: the box it is clipped to grows by as much. */
+    r->delta = far > FAR_MOVE * t->ext ? t->delta + t->ulps * m : t->delta;
+    if (!clip_ray(t, ol, tmin, tmax, r)) return 0;
+    if (!(far > FAR_MOVE * t->ext)) return 1;
+    r->delta = t->delta;
+    r->toff = r->t0;
+    for (a = 0; a < 3; a++) ol[a] = prims_along(org[a], t->c[a], r->toff, dir[a]);
+    return clip_ray(t, ol, tmin - r->toff, tmax - r->toff, r);
+}
+
+/* The latest t of the walk's (see setup_ray) at which the point of a hit at
+ * the caller's t may lie. */
+static inline double reach(const kd_ray *r, double t)
+{
+    return t - r->toff + r->slack;
 }
 
 static void push(kd_todo *stack, int *n, uint32_t node, double t0, double t1)
@@ -331,7 +401,7 @@ static int tree_intersect(const kd_tree *t, const prims *p, kd_ray *r,
         return test_leaf(t, nd, p, r, ray, tmin, any, best_t, best, &c->tests);
     w.node = step(nd, r, &w.t0, &w.t1, &far, &n);
     best = tree_intersect(t, p, r, ray, tmin, any, w, best_t, best, c);
-    if ((any && best >= 0) || pop(&far, &n, *best_t) < 0) return best;
+    if ((any && best >= 0) || pop(&far, &n, reach(r, *best_t)) < 0) return best;
     return tree_intersect(t, p, r, ray, tmin, any, far, best_t, best, c);
 }
 
@@ -361,7 +431,7 @@ static int walk(const kd_tree *t, const prims *p, kd_ray *r,
         }
         best = test_leaf(t, nd, p, r, ray, tmin, any, best_t, best, &tests);
         if (any && best >= 0) break;
-        next = pop(stack, &n, *best_t);
+        next = pop(stack, &n, reach(r, *best_t));
         if (next < 0) break;
         node = stack[next].node, t0 = stack[next].t0, t1 = stack[next].t1;
     }
@@ -414,8 +484,8 @@ int kd_intersect_recursive(const kd_tree *t, const prims *p,
 
 /* ---- boxes -------------------------------------------------------------- */
 
-/* Boxes are kept in float, the precision of the split planes, rounded to
- * nearest.  Two triangles sharing an edge at x = 1/3, a number no float
+/* Boxes are kept in float, the precision of the split planes, in the
+ * tree's frame (see RAY_EPS), rounded to nearest.  Two triangles sharing an edge at x = 1/3, a number no float
  * holds, then end and start at the same float, and a plane there parts them
  * cleanly.  Rounded outwards instead, their boxes would overlap by one
  * float step, and every plane through a mesh's vertices would cut the
@@ -434,15 +504,16 @@ static float to_float(double x)
     return x > FLT_MAX ? FLT_MAX : x < -FLT_MAX ? -FLT_MAX : (float)x;
 }
 
-/* Box of lo..hi.  0 for NaN or lo > hi: such a primitive has no place in
- * space and is left out of the tree. */
-static int make_box(const double lo[3], const double hi[3], kd_box *b)
+/* Box of lo..hi (the caller's coordinates) in the frame centred on c.  0
+ * for NaN or lo > hi: such a primitive has no place in space and is left
+ * out of the tree. */
+static int make_box(const double lo[3], const double hi[3], const double c[3], kd_box *b)
 {
     int a;
     for (a = 0; a < 3; a++) {
         if (!(lo[a] <= hi[a])) return 0;
-        b->lo[a] = to_float(lo[a]);
-        b->hi[a] = to_float(hi[a]);
+        b->lo[a] = to_float(lo[a] - c[a]);
+        b->hi[a] = to_float(hi[a] - c[a]);
     }
     return 1;
 }
@@ -594,6 +665,8 @@ enum { LEFT = -1, RIGHT = -2, BOTH = -3 };
 
 typedef struct {
     const prims *p;
+    double c[3];          /* the frame (see RAY_EPS) */
+    double wlo[3], whi[3];  /* the scene box in the caller's coordinates */
     kd_node *nodes;
     long nnodes, node_cap;
     int *refs;
@@ -769,7 +842,9 @@ static void recall_boxes(const kd_builder *b, const kd_list *L, kd_box *cut)
  * callback's rounding.  0 when nothing of the primitive is in the cell.
  * The callback is shown the cell grown by two float steps: a primitive that
  * rounding to nearest put in this cell may lie up to half a step outside
- * it, and must not be dropped for that. */
+ * it, and must not be dropped for that.  The cell goes to the caller's
+ * coordinates in one rounded addition, which cannot cross a coordinate of
+ * the caller's (rounding is monotonic), so it still holds whatever it held. */
 static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
                      const kd_box *cell, kd_box *out)
 {
@@ -783,11 +858,11 @@ static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
     if (b->p->clip) {
         double clo[3], chi[3], lo[3], hi[3];
         for (a = 0; a < 3; a++) {
-            clo[a] = nextafterf(nextafterf(cell->lo[a], -FLT_MAX), -FLT_MAX);
-            chi[a] = nextafterf(nextafterf(cell->hi[a], FLT_MAX), FLT_MAX);
+            clo[a] = b->c[a] + nextafterf(nextafterf(cell->lo[a], -FLT_MAX), -FLT_MAX);
+            chi[a] = b->c[a] + nextafterf(nextafterf(cell->hi[a], FLT_MAX), FLT_MAX);
         }
         if (!b->p->clip(b->p->user, prim, clo, chi, lo, hi)) return 0;
-        if (!make_box(lo, hi, out)) return 1;  /* NaN: keep the old box */
+        if (!make_box(lo, hi, b->c, out)) return 1;  /* NaN: keep the old box */
         for (a = 0; a < 3; a++) {
             out->lo[a] = clampf(out->lo[a], old.lo[a], old.hi[a]);
             out->hi[a] = clampf(out->hi[a], old.lo[a], old.hi[a]);
@@ -1082,11 +1157,12 @@ static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
     int i, a;
     memset(scene, 0, sizeof *scene);
     if (!alloc_list(L, 2 * (long)n)) return 0;
+    prims_frame(b->p, n, b->wlo, b->whi, b->c);   /* one more call of bounds per primitive */
     for (i = 0; i < n; i++) {
         double lo[3], hi[3];
         kd_box box;
         b->p->bounds(b->p->user, i, lo, hi);
-        if (!make_box(lo, hi, &box)) continue;
+        if (!make_box(lo, hi, b->c, &box)) continue;
         for (a = 0; a < 3; a++) {
             if (L->count == 0 || box.lo[a] < scene->lo[a]) scene->lo[a] = box.lo[a];
             if (L->count == 0 || box.hi[a] > scene->hi[a]) scene->hi[a] = box.hi[a];
@@ -1115,12 +1191,15 @@ static kd_tree *finish(kd_builder *b, const kd_box *scene)
     t->prims = (int *)(t->nodes + b->nnodes);
     if (rb) memcpy(t->prims, b->refs, rb);
     t->bytes = nb + rb;
-    t->scale = 0;
+    t->scale = t->ext = 0;
     for (a = 0; a < 3; a++) {
+        t->c[a] = b->c[a];
         t->lo[a] = scene->lo[a], t->hi[a] = scene->hi[a];
-        if (fabs(t->lo[a]) > t->scale) t->scale = fabs(t->lo[a]);
-        if (fabs(t->hi[a]) > t->scale) t->scale = fabs(t->hi[a]);
+        t->ext = fmax(t->ext, fmax(fabs(t->lo[a]), fabs(t->hi[a])));
+        t->scale = fmax(t->scale, fmax(fabs(b->wlo[a]), fabs(b->whi[a])));
     }
+    t->ulps = PRIMS_HIT_ULPS * (b->p->eps > 0 ? b->p->eps : DBL_EPSILON);
+    t->delta = RAY_EPS * t->ext + t->ulps * t->scale;
     t->info = b->info;
     t->info.bytes = t->bytes;
     t->info.prims_per_leaf = t->info.leaves > t->info.empty_leaves
@@ -1179,7 +1258,7 @@ long kd_splits(const kd_tree *t, int *axis, double *pos, long max)
     for (i = 0; i < t->info.nodes; i++) {
         const kd_node *n = &t->nodes[i];
         if (node_axis(n) == (int)LEAF) continue;
-        if (k < max) axis[k] = node_axis(n), pos[k] = n->u.split;
+        if (k < max) axis[k] = node_axis(n), pos[k] = t->c[node_axis(n)] + n->u.split;
         k++;
     }
     return k;

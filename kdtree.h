@@ -70,8 +70,10 @@ void kd_free(kd_tree *t);
 /* For tests and for the curious.  kd_bytes: the built tree as one block of
  * bytes (the 8-byte nodes, then the leaves' lists of primitive numbers);
  * two builds of the same input give equal blocks.  kd_splits: the axis
- * (0, 1, 2) and position of each inner node's plane, in node order; writes
- * at most max pairs and returns the number of inner nodes. */
+ * (0, 1, 2) and position of each inner node's plane, in node order, in the
+ * caller's coordinates (the tree keeps it as a float relative to a centre
+ * of its own, so this is the nearest double); writes at most max pairs and
+ * returns the number of inner nodes. */
 const void *kd_bytes(const kd_tree *t, size_t *size);
 long kd_splits(const kd_tree *t, int *axis, double *pos, long max);
 #endif

@@ -1341,6 +1341,25 @@ static int prim_clip(void *user, int i, const double blo[3], const double bhi[3]
 
 /* ------------------------------------------------- the primitives: spheres */
 
+/* A ray whose origin is farther than FAR_MOVE times a primitive's size
+ * from it is first moved along itself to near the primitive, by
+ * near_point, before the primitive's test: the contract of prims.h lets a
+ * hit from afar err along the ray by a rounding of |o|, but off it only by
+ * a rounding of the primitive's own coordinates.  (In double, spheres and
+ * cones would keep it without; the float build's would not.) */
+#define FAR_MOVE 4096
+
+/* o + t d - v, summed exactly and rounded once per coordinate
+ * (prims_along, prims.h): for a point of the ray near v, exact to a
+ * rounding of itself.  Rounded step by step, the point would lie off the
+ * ray by a rounding of |o| (1e-3 from 1e13 away), and a test made from
+ * there would see a ray shifted sideways by that much. */
+static vec near_point(vec o, real t, vec d, vec v)
+{
+    return v3((real)prims_along(o.x, v.x, t, d.x), (real)prims_along(o.y, v.y, t, d.y),
+              (real)prims_along(o.z, v.z, t, d.z));
+}
+
 /* Smallest root t of |o + t d - c| = r with t > tmin, or INFINITY.
  *
  * The textbook form b*b - c loses every digit when the sphere is far away or
@@ -1351,21 +1370,26 @@ static int prim_clip(void *user, int i, const double blo[3], const double bhi[3]
  * equal numbers (Haines, Guenter, Jones, Akenine-Moller and Hunt, "Precision
  * Improvements for Ray/Sphere Intersection", Ray Tracing Gems, ch. 7, 2019).
  * l is kept multiplied by a = d.d, so that a miss, the common case in a
- * tree's leaf, costs no division. */
+ * tree's leaf, costs no division.  f = o - c itself is rounded by eps |o|,
+ * which from afar shifts the ray sideways, so a far ray starts from the
+ * point level with the centre (FAR_MOVE). */
 static real hit_sphere(const Sphere *sp, const Ray *r, real tmin)
 {
-    vec f = sub(r->o, sp->cen);
-    real a = dot(r->d, r->d);
-    real b = -dot(f, r->d);                      /* half of -B in a t^2 + B t + C */
-    vec l = comb(b, r->d, scale(a, f));          /* a l */
-    real ar = a * sp->rad, disc = ar * ar - dot(l, l);   /* a^2 (r^2 - l.l) */
-    real c, q, t0, t1;
+    vec f = sub(r->o, sp->cen), l;
+    real a = dot(r->d, r->d), tm = 0, b, ar, disc, c, q, t0, t1;
+    if (maxabs(f) > FAR_MOVE * sp->rad) {       /* from afar: start level with the centre */
+        tm = -dot(f, r->d) / a;
+        f = near_point(r->o, tm, r->d, sp->cen);
+    }
+    b = -dot(f, r->d);                          /* half of -B in a t^2 + B t + C */
+    l = comb(b, r->d, scale(a, f));             /* a l */
+    ar = a * sp->rad, disc = ar * ar - dot(l, l);   /* a^2 (r^2 - l.l) */
     if (!(disc >= 0)) return INFINITY;          /* also rejects NaN */
     disc /= a;                                  /* the quarter discriminant */
     c = dot(f, f) - sp->rad * sp->rad;
     q = b + (b >= 0 ? sqrt(disc) : -sqrt(disc));
-    t0 = c / q;
-    t1 = q / a;
+    t0 = tm + c / q;
+    t1 = tm + q / a;
     if (t0 > t1) { real tt = t0; t0 = t1; t1 = tt; }
     if (t0 > tmin) return t0;
     if (t1 > tmin) return t1;
@@ -1470,12 +1494,16 @@ static real sphere_pdf(const Sphere *sp, vec x, vec y)
  * Precision: B^2 - AC cancels when the ray starts far from the cone (its
  * terms grow with the distance squared).  So the ray is first moved along
  * itself to t0, level with the cone's middle, the quadratic solved from
- * there, and t0 added back: the same idea as the sphere's closest point.
+ * there, and t0 added back: the same idea as the sphere's closest point
+ * (from farther than FAR_MOVE times the cone's size, the point at t0 is
+ * summed exactly, for prims.h).
  * The roots then come from q and C/q, so that neither subtracts. */
 static real hit_cone(const Cone *c, const Ray *r, real tmin)
 {
     real t0 = dot(sub(comb(c->len / 2, c->axis, c->base), r->o), r->d) / dot(r->d, r->d);
-    vec q = sub(comb(t0, r->d, r->o), c->base);
+    vec q = maxabs(sub(r->o, c->base)) > FAR_MOVE * (c->len + c->ra + c->rb)
+            ? near_point(r->o, t0, r->d, c->base)   /* from afar, summed exactly */
+            : sub(comb(t0, r->d, r->o), c->base);
     real k = (c->ra - c->rb) / c->len;
     real qh = dot(q, c->axis), dh = dot(r->d, c->axis);
     vec qx = comb(-qh, c->axis, q), dx = comb(-dh, c->axis, r->d); /* across the axis */
@@ -1605,12 +1633,29 @@ static int watertight_inside(vec a, vec b, vec c, const Ray *r)
  *    (-DREAL=float) the rounding of u and v grows with the ray's distance
  *    beyond 1e-7 of det (a mesh seen from afar showed holes), so there the
  *    margin also covers a bound on that: 96 ulps of |o - v0| |d| |e|.
+ * And one for rays from afar.  From D times its size away, o - v0 is
+ * rounded by eps D, and the cross and dot products of it with the edges
+ * cancel: t, u and v err by eps D divided by the sines of the grazing angle
+ * and of the triangle's smallest angle (from 10^13 away, by more than the
+ * triangle's size, and the mesh leaks).  The acceleration structures need
+ * the hit point off the triangle's box by no more than a few eps of the
+ * triangle's coordinates, and along the ray by a few eps of |o| (prims.h),
+ * so a ray from farther than FAR_MOVE times the triangle's size is first
+ * moved along itself to the point nearest v0, summed exactly (near_point),
+ * as hit_sphere and hit_cone move theirs; the test is made from there, and
+ * the distance moved added to t.  u and v are then exact to the
+ * triangle's own rounding, and t to a rounding of itself.  Rays that fall
+ * within the 1e-7
+ * of an edge still get the exact test from the caller's own origin, which
+ * every triangle around the edge shares: the mesh stays watertight.
+ * Nearer rays take the lecture's path unchanged.
  * Returns 1 and t, u, v (barycentrics of v1 and v2) on a hit. */
 static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
                         real *t, real *u, real *v)
 {
     vec v0 = tr->v0, e1 = tr->e1, e2 = tr->e2, p = cross(r->d, e2), tv, q;
-    real det = dot(e1, p), sign = det < 0 ? -1 : 1, slack, uu, vv, tt;
+    real det = dot(e1, p), sign = det < 0 ? -1 : 1, slack, uu, vv, tt, t0 = 0, size;
+    int far;
     if (tr->degenerate || isnan(det)) return 0;
     if (tr->cull) {                      /* the lecture's culling branch */
         if (!(det > 0)) return 0;
@@ -1619,18 +1664,24 @@ static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real t
     det *= sign;                         /* from here on det > 0 */
     tv = sub(r->o, v0);                   /* u, v and t, each times det */
     slack = (real)1e-7 * det;
+    size = maxabs(e1) + maxabs(e2);
+    far = maxabs(tv) > FAR_MOVE * size;
+    if (far) {                           /* see above: from afar, start near v0 */
+        t0 = -dot(tv, r->d) / dot(r->d, r->d);
+        tv = near_point(r->o, t0, r->d, v0);
+    }
     if (sizeof(real) == sizeof(float))   /* see above: float's rounding outgrows 1e-7 */
-        slack += 96 * REAL_EPS * maxabs(tv) * maxabs(r->d) * (maxabs(e1) + maxabs(e2));
+        slack += 96 * REAL_EPS * maxabs(tv) * maxabs(r->d) * size;
     uu = sign * dot(tv, p);
     if (uu < -slack || uu > det + slack) return 0;
     q = cross(tv, e1);
     vv = sign * dot(r->d, q);
     if (vv < -slack || uu + vv > det + slack) return 0;
     tt = sign * dot(e2, q);
-    if (!(tt > 0)) return 0;             /* behind the origin, or NaN */
+    if (far ? !(t0 + tt / det > 0) : !(tt > 0)) return 0;   /* behind the origin, or NaN */
     if ((uu < 0 || vv < 0 || uu + vv > det)
         && !watertight_inside(v0, s->vert[tr->v[1]], s->vert[tr->v[2]], r)) return 0;
-    *t = tt / det;      /* compared after the division: a tie at tmax must be exact */
+    *t = far ? t0 + tt / det : tt / det;   /* compared after the division: a tie at tmax must be exact */
     if (!(*t <= tmax) || (r->tmin > 0 && !(*t > r->tmin))) return 0;
     *u = uu / det;
     *v = vv / det;
@@ -3650,6 +3701,7 @@ static int build_accel(Scene *s, const char *accel)
     s->prims.clip = prim_clip;
     s->prims.hit = prim_hit;
     s->prims.user = s;
+    s->prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
     s->accel = ACCEL_NONE;
     if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
     if (!float_range(s)) {

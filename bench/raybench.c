@@ -18,6 +18,10 @@
  *                                    every structure on the same rays, taking turns
  *     raybench anim SCENE.nff FRAMES MOVERS [ROUNDS]
  *                                    rebuild or refit as objects move
+ *     raybench far SCENE W H N       kd, bvh and grid with the scene moved to
+ *                                    1e4, 1e6 and 1e8 from the origin, and the
+ *                                    camera to 1e10 and 1e13 from the scene:
+ *                                    Mrays/s as a ratio to the origin's
  *
  * ray.c is included whole, as tests/test_ray.c does, so that what is timed is
  * the renderer's real triangle test, clip callback and tree walk, not a copy
@@ -197,42 +201,69 @@ static int rb_nff_view(const char *path, double eye[3], double at[3], double up[
     return got == 4;
 }
 
-/* Primary rays by embree_rays' stated pinhole convention: without a view,
- * looking down -z at the box centre from where the bounding sphere just
- * fills the 45-degree vertical field of view; with one, the NFF camera. */
-static RbRay *rb_primary(const Scene *s, int w, int h, const char *view)
+/* The camera of the primary rays, by embree_rays' stated pinhole
+ * convention: without a view, looking down -z at the box centre from where
+ * the bounding sphere just fills the 45-degree vertical field of view; with
+ * one, the NFF camera.  dist > 0 moves the eye back along its line of sight
+ * to dist from the point it looks at, the field of view narrowed to frame
+ * the same picture (raybench far). */
+typedef struct { double eye[3], f[3], r[3], u[3], th; } RbCamera;
+
+static RbCamera rb_camera(const Scene *s, const char *view, double dist)
 {
     RbBox b = rb_box(s);
-    double eye[3], at[3], up[3] = { 0, 1, 0 }, f[3], r[3], u[3], fov = 45, th;
+    RbCamera c;
+    double at[3], up[3] = { 0, 1, 0 }, fov = 45, len;
+    int k;
+    if (view) {
+        if (!rb_nff_view(view, c.eye, at, up, &fov)) rb_die("no from, at, up and angle in", view);
+    } else {
+        double d0 = b.R / sin(0.5 * fov * RB_PI / 180);
+        for (k = 0; k < 3; k++) at[k] = b.c[k];
+        c.eye[0] = b.c[0]; c.eye[1] = b.c[1]; c.eye[2] = b.c[2] + d0;   /* dir (0, 0, -1) */
+    }
+    c.th = tan(0.5 * fov * RB_PI / 180);
+    for (k = 0; k < 3; k++) c.f[k] = at[k] - c.eye[k];
+    if (dist > 0) {
+        len = sqrt(c.f[0] * c.f[0] + c.f[1] * c.f[1] + c.f[2] * c.f[2]);
+        for (k = 0; k < 3; k++) c.eye[k] = at[k] - c.f[k] / len * dist;
+        c.th *= len / dist;
+    }
+    rb_norm(c.f);
+    rb_cross(c.f, up, c.r);
+    if (sqrt(c.r[0] * c.r[0] + c.r[1] * c.r[1] + c.r[2] * c.r[2]) < 1e-6) {  /* up along the view */
+        double up2[3] = { 0, 0, 1 };
+        if (fabs(c.f[2]) > 0.9) up2[1] = 1, up2[2] = 0;
+        rb_cross(c.f, up2, c.r);
+    }
+    rb_norm(c.r);
+    rb_cross(c.r, c.f, c.u);
+    return c;
+}
+
+/* The unit direction through the centre of pixel x, y of w x h. */
+static void rb_pixel(const RbCamera *c, int w, int h, int x, int y, double d[3])
+{
+    double sx = (2.0 * (x + 0.5) / w - 1) * c->th * ((double)w / h);
+    double sy = (1 - 2.0 * (y + 0.5) / h) * c->th;
+    int k;
+    for (k = 0; k < 3; k++) d[k] = c->f[k] + sx * c->r[k] + sy * c->u[k];
+    rb_norm(d);
+}
+
+/* W x H primary rays from the camera (rb_camera). */
+static RbRay *rb_primary(const Scene *s, int w, int h, const char *view)
+{
+    RbCamera c = rb_camera(s, view, 0);
     RbRay *rays = malloc((size_t)w * h * sizeof *rays);
     int x, y, k;
     if (!rays) rb_die("out of memory for primary rays", NULL);
-    if (view) {
-        if (!rb_nff_view(view, eye, at, up, &fov)) rb_die("no from, at, up and angle in", view);
-    } else {
-        double dist = b.R / sin(0.5 * fov * RB_PI / 180);
-        for (k = 0; k < 3; k++) at[k] = b.c[k];
-        eye[0] = b.c[0]; eye[1] = b.c[1]; eye[2] = b.c[2] + dist;   /* dir (0, 0, -1) */
-    }
-    th = tan(0.5 * fov * RB_PI / 180);
-    for (k = 0; k < 3; k++) f[k] = at[k] - eye[k];
-    rb_norm(f);
-    rb_cross(f, up, r);
-    if (sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) < 1e-6) {  /* up along the view */
-        double up2[3] = { 0, 0, 1 };
-        if (fabs(f[2]) > 0.9) up2[1] = 1, up2[2] = 0;
-        rb_cross(f, up2, r);
-    }
-    rb_norm(r);
-    rb_cross(r, f, u);
     for (y = 0; y < h; y++)
         for (x = 0; x < w; x++) {
-            double sx = (2.0 * (x + 0.5) / w - 1) * th * ((double)w / h);
-            double sy = (1 - 2.0 * (y + 0.5) / h) * th, d[3];
+            double d[3];
             RbRay *ry = &rays[(size_t)y * w + x];
-            for (k = 0; k < 3; k++) d[k] = f[k] + sx * r[k] + sy * u[k];
-            rb_norm(d);
-            for (k = 0; k < 3; k++) ry->o[k] = (float)eye[k], ry->d[k] = (float)d[k];
+            rb_pixel(&c, w, h, x, y, d);
+            for (k = 0; k < 3; k++) ry->o[k] = (float)c.eye[k], ry->d[k] = (float)d[k];
             ry->t = 0;
             ry->prim = -2;
         }
@@ -1025,6 +1056,233 @@ static void rb_anim(const char *path, int frames, int movers, int rounds)
     for (k = 0; k < 4; k++) rb_free_scene(&s[k]);
 }
 
+/* ------------------------------------------------- far from the origin */
+
+/* `raybench far SCENE W H N` asks whether each structure keeps its speed
+ * when the scene lies far from the origin or the camera far from the scene.
+ * The scene is loaded again for each configuration and moved, in memory,
+ * by (off, off, off) as if its file said so (vertices, centres and bases
+ * moved, each triangle's edges recomputed from its moved vertices): at the
+ * origin, and offset by 1e4, 1e6 and 1e8; its W x H primary rays (from the
+ * scene's camera, as `accel` makes them) and N random rays (origins in the
+ * box x1.5) are moved with it.  Then, the scene at the origin, the camera is
+ * moved back along its line of sight to 1e10 and 1e13 from the point it
+ * looks at, its field of view narrowed to frame the same picture.  The rays
+ * are made and kept in double here: a float could not hold an origin at
+ * 1e8 to better than 8 units.  Every structure (kd, bvh, grid) is traced on
+ * every configuration in each of RB_ROUNDS rounds, structures and
+ * configurations taking turns; Mrays/s by thread CPU time, best, median and
+ * worst round, and each median over the structure's median at the origin.
+ * Every 16th ray is also asked of a loop over every object, and each
+ * structure's answers (object, bitwise t) must be the loop's. */
+typedef struct { double o[3], d[3]; } RbDRay;
+
+#define RB_FAR_N 6
+static const char *const rb_far_names[RB_FAR_N] = {
+    "origin", "offset1e4", "offset1e6", "offset1e8", "camera1e10", "camera1e13"
+};
+static const double rb_far_off[RB_FAR_N] = { 0, 1e4, 1e6, 1e8, 0, 0 };
+static const double rb_far_dist[RB_FAR_N] = { 0, 0, 0, 0, 1e10, 1e13 };
+static const char *const rb_far_accels[3] = { "kd", "bvh", "grid" };
+
+typedef struct {
+    Scene s;
+    kd_tree *kd;
+    bvh *bvh;
+    grid *grid;
+    RbDRay *rays[2];     /* primary, random (NULL: none) */
+    long n[2];
+    int *want[2];        /* the loop's answer on every 16th ray */
+    double *want_t[2];
+} RbFar;
+
+static void rb_far_translate(Scene *s, double off)
+{
+    vec o = v3(off, off, off);
+    int i;
+    for (i = 0; i < s->nvert; i++) s->vert[i] = add(s->vert[i], o);
+    for (i = 0; i < s->nsph; i++) s->sph[i].cen = add(s->sph[i].cen, o);
+    for (i = 0; i < s->ncone; i++) s->cone[i].base = add(s->cone[i].base, o);
+    for (i = 0; i < s->nlight; i++) s->light[i].pos = add(s->light[i].pos, o);
+    for (i = 0; i < s->ntri; i++) {   /* as add_triangle computes them */
+        Triangle *tr = &s->tri[i];
+        vec a = s->vert[tr->v[0]], b = s->vert[tr->v[1]], c = s->vert[tr->v[2]];
+        tr->v0 = a;
+        tr->e1 = sub(b, a);
+        tr->e2 = sub(c, a);
+        tr->degenerate = (char)degenerate(a, b, c);
+    }
+}
+
+/* Primary rays as rb_primary makes them, in double, from a camera moved by
+ * off, or moved back to dist from the point it looks at (rb_camera). */
+static RbDRay *rb_far_primary(const Scene *s, int w, int h, const char *view, double off, double dist)
+{
+    RbCamera c = rb_camera(s, view, dist);
+    RbDRay *rays = malloc((size_t)w * h * sizeof *rays);
+    int x, y, k;
+    if (!rays) rb_die("out of memory for primary rays", NULL);
+    for (y = 0; y < h; y++)
+        for (x = 0; x < w; x++) {
+            RbDRay *ry = &rays[(size_t)y * w + x];
+            rb_pixel(&c, w, h, x, y, ry->d);
+            for (k = 0; k < 3; k++) ry->o[k] = c.eye[k] + off;
+        }
+    return rays;
+}
+
+/* rb_random's rays (seed 1), in double, moved by off. */
+static RbDRay *rb_far_random(const Scene *s, long n, double off)
+{
+    RbRay *r = rb_random(s, n, 1);
+    RbDRay *rays = malloc((size_t)n * sizeof *rays);
+    long i;
+    int k;
+    if (!rays) rb_die("out of memory for random rays", NULL);
+    for (i = 0; i < n; i++)
+        for (k = 0; k < 3; k++) rays[i].o[k] = r[i].o[k] + off, rays[i].d[k] = r[i].d[k];
+    free(r);
+    return rays;
+}
+
+/* The nearest hit of ray r through structure which (0 kd, 1 bvh, 2 grid,
+ * 3 the loop over every object), its t in *t. */
+static int rb_far_nearest(const RbFar *F, int which, const RbDRay *r, double *t, prim_counters *c)
+{
+    const prims *p = &F->s.prims;
+    Ray ry;
+    Query q;
+    int i, best = -1, n = nobj(&F->s);
+    ry.o = v3(r->o[0], r->o[1], r->o[2]), ry.d = v3(r->d[0], r->d[1], r->d[2]);
+    ry.skip = -1, ry.tmin = 0;
+    q = query(ry);
+    *t = INFINITY;
+    switch (which) {
+    case 0: return kd_nearest(F->kd, p, r->o, r->d, &q, -1, 0, t, c);
+    case 1: return bvh_nearest(F->bvh, p, r->o, r->d, &q, -1, 0, t, c);
+    case 2: return grid_nearest(F->grid, p, r->o, r->d, &q, -1, 0, t, c);
+    }
+    for (i = 0; i < n; i++) {
+        double th;
+        if (p->hit(p->user, i, &q, 0, *t, &th) && th < *t) *t = th, best = i;
+    }
+    return best;
+}
+
+static void rb_far_setup(RbFar *F, const char *path, int cfg, int w, int h, long nrand)
+{
+    const char *dot = strrchr(path, '.');
+    int nff = dot && !strcmp(dot, ".nff"), k;
+    long i;
+    memset(F, 0, sizeof *F);
+    if (nff) {
+        default_scene(&F->s);
+        if (!load_scene(&F->s, path)) exit(1);
+    } else
+        rb_load_mesh(&F->s, path);
+    F->rays[0] = rb_far_primary(&F->s, w, h, nff ? path : NULL, rb_far_off[cfg], rb_far_dist[cfg]);
+    F->n[0] = (long)w * h;
+    if (rb_far_dist[cfg] == 0) F->rays[1] = rb_far_random(&F->s, nrand, rb_far_off[cfg]), F->n[1] = nrand;
+    rb_far_translate(&F->s, rb_far_off[cfg]);
+    if (!build_accel(&F->s, "none")) exit(1);
+    F->kd = kd_build(nobj(&F->s), &F->s.prims);
+    F->bvh = bvh_build(nobj(&F->s), &F->s.prims, BVH_SAH);
+    F->grid = grid_build(nobj(&F->s), &F->s.prims);
+    if (!F->kd || !F->bvh || !F->grid) rb_die("out of memory building the structures", NULL);
+    for (k = 0; k < 2; k++) {
+        if (!F->rays[k]) continue;
+        F->want[k] = malloc(((size_t)F->n[k] / 16 + 1) * sizeof(int));
+        F->want_t[k] = malloc(((size_t)F->n[k] / 16 + 1) * sizeof(double));
+        if (!F->want[k] || !F->want_t[k]) rb_die("out of memory", NULL);
+        for (i = 0; i < F->n[k]; i += 16)
+            F->want[k][i / 16] = rb_far_nearest(F, 3, &F->rays[k][i], &F->want_t[k][i / 16], NULL);
+    }
+}
+
+static void rb_far_free(RbFar *F)
+{
+    int k;
+    kd_free(F->kd), bvh_free(F->bvh), grid_free(F->grid);
+    F->s.kd = NULL, F->s.bvh = NULL, F->s.grid = NULL;
+    for (k = 0; k < 2; k++) free(F->rays[k]), free(F->want[k]), free(F->want_t[k]);
+    rb_free_scene(&F->s);
+}
+
+/* One pass of structure which over ray set k of F: thread CPU seconds. */
+static double rb_far_pass(const RbFar *F, int which, int k, prim_counters *c, long *differ)
+{
+    double c0 = rb_cpu(), t;
+    long i;
+    for (i = 0; i < F->n[k]; i++) {
+        int got = rb_far_nearest(F, which, &F->rays[k][i], &t, c);
+        if (differ && i % 16 == 0
+            && (got != F->want[k][i / 16] || memcmp(&t, &F->want_t[k][i / 16], sizeof t)))
+            ++*differ;
+    }
+    return rb_cpu() - c0;
+}
+
+static void rb_far(const char *path, int w, int h, long nrand)
+{
+    RbFar *F = malloc(RB_FAR_N * sizeof *F);
+    double secs[RB_FAR_N][3][2][RB_ROUNDS], med0[3][2] = { { 0 } };
+    prim_counters c[RB_FAR_N][3][2];
+    long differ[RB_FAR_N][3][2];
+    static char res[RB_FAR_N][3][2][256];   /* the result lines, printed after the table */
+    int cfg, a, k, r;
+    if (!F) rb_die("out of memory", NULL);
+    for (cfg = 0; cfg < RB_FAR_N; cfg++) rb_far_setup(&F[cfg], path, cfg, w, h, nrand);
+    memset(c, 0, sizeof c), memset(differ, 0, sizeof differ);
+    for (cfg = 0; cfg < RB_FAR_N; cfg++)   /* untimed: the work, and the answers against the loop */
+        for (a = 0; a < 3; a++)
+            for (k = 0; k < 2; k++)
+                if (F[cfg].rays[k]) rb_far_pass(&F[cfg], a, k, &c[cfg][a][k], &differ[cfg][a][k]);
+    for (r = 0; r < RB_ROUNDS; r++)
+        for (cfg = 0; cfg < RB_FAR_N; cfg++)
+            for (a = 0; a < 3; a++)
+                for (k = 0; k < 2; k++)
+                    if (F[cfg].rays[k]) secs[cfg][a][k][r] = rb_far_pass(&F[cfg], a, k, NULL, NULL);
+    printf("far from the origin: %s, %d objects; %dx%d primary rays, %ld random; Mrays/s by thread CPU time,\n"
+           "best / median / worst of %d rounds, the structures and configurations taking turns; ratio: the\n"
+           "median over the same structure's at the origin; steps and tests per ray; answers: every 16th ray\n"
+           "against the loop over every object (object and bitwise t)\n", path, nobj(&F[0].s), w, h, nrand,
+           RB_ROUNDS);
+    printf("%-11s %-5s  %-20s %6s %6s %7s  %-20s %6s %6s %7s  %s\n", "config", "accel", "primary Mrays/s",
+           "ratio", "steps", "tests", "random Mrays/s", "ratio", "steps", "tests", "answers");
+    for (cfg = 0; cfg < RB_FAR_N; cfg++)
+        for (a = 0; a < 3; a++) {
+            double fig[2][3];
+            printf("%-11s %-5s", rb_far_names[cfg], rb_far_accels[a]);
+            for (k = 0; k < 2; k++) {
+                double mr[RB_ROUNDS];
+                long n = F[cfg].n[k];
+                if (!F[cfg].rays[k]) {
+                    printf("  %-20s %6s %6s %7s", "-", "-", "-", "-");
+                    continue;
+                }
+                for (r = 0; r < RB_ROUNDS; r++) mr[r] = n / secs[cfg][a][k][r] * 1e-6;
+                qsort(mr, RB_ROUNDS, sizeof mr[0], rb_cmp_double);
+                fig[k][0] = mr[RB_ROUNDS - 1], fig[k][1] = mr[RB_ROUNDS / 2], fig[k][2] = mr[0];
+                if (cfg == 0) med0[a][k] = fig[k][1];
+                printf("  %6.2f %6.2f %6.2f %6.3f %6.1f %7.2f", fig[k][0], fig[k][1], fig[k][2],
+                       fig[k][1] / med0[a][k], (double)c[cfg][a][k].steps / n, (double)c[cfg][a][k].tests / n);
+            }
+            printf("  %s\n", differ[cfg][a][0] + differ[cfg][a][1] ? "DIFFER from the loop" : "same as the loop");
+            for (k = 0; k < 2; k++)
+                if (F[cfg].rays[k])
+                    sprintf(res[cfg][a][k], "result far=%s accel=%s set=%s rays=%ld best=%.4f median=%.4f "
+                            "worst=%.4f ratio=%.4f steps=%.3f tests=%.3f differ=%ld\n", rb_far_names[cfg],
+                            rb_far_accels[a], k ? "random" : "primary", F[cfg].n[k], fig[k][0], fig[k][1],
+                            fig[k][2], fig[k][1] / med0[a][k], (double)c[cfg][a][k].steps / F[cfg].n[k],
+                            (double)c[cfg][a][k].tests / F[cfg].n[k], differ[cfg][a][k]);
+        }
+    for (cfg = 0; cfg < RB_FAR_N; cfg++)
+        for (a = 0; a < 3; a++)
+            for (k = 0; k < 2; k++) printf("%s", res[cfg][a][k]);
+    for (cfg = 0; cfg < RB_FAR_N; cfg++) rb_far_free(&F[cfg]);
+    free(F);
+}
+
 /* The rays made here for `made` and `accel`: W x H primary rays (arg[0],
  * arg[1]) from the view, then N random ones (arg[2]), each set handed to
  * trace with ctx. */
@@ -1060,7 +1318,9 @@ static void rb_usage(void)
           "                                                random rays; SCENE .obj or .nff)\n"
           "       raybench accel SCENE RAYS.bin...        (every structure on RAYHITS1 rays)\n"
           "       raybench anim SCENE.nff FRAMES MOVERS [ROUNDS]\n"
-          "                                               (rebuild or refit as objects move; 3 rounds)\n", stderr);
+          "                                               (rebuild or refit as objects move; 3 rounds)\n"
+          "       raybench far SCENE W H N                (kd, bvh, grid with the scene moved to 1e4, 1e6,\n"
+          "                                                1e8 and the camera to 1e10, 1e13)\n", stderr);
     exit(2);
 }
 
@@ -1075,6 +1335,10 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "anim") && (argc == 5 || argc == 6)) {
         rb_anim(argv[2], (int)rb_count(argv[3], 100000), (int)strtol(argv[4], NULL, 10),
                 argc == 6 ? (int)rb_count(argv[5], RB_ANIM_ROUNDS_MAX) : 3);
+        return 0;
+    }
+    if (!strcmp(argv[1], "far") && argc == 6) {
+        rb_far(argv[2], (int)rb_count(argv[3], 32768), (int)rb_count(argv[4], 32768), rb_count(argv[5], 100000000));
         return 0;
     }
     if (!strcmp(argv[1], "accel") && argc >= 4) {

@@ -46,6 +46,12 @@
 #           refitting the BVH, rebuilding the grid, taking turns at each
 #           frame; the whole animation in BENCH_ROUNDS rounds
 #           (bench/raybench.c anim)
+#   far     kd, bvh and grid far from the origin, one thread: the 100k-triangle
+#           sphere moved to 1e4, 1e6 and 1e8, and the camera to 1e10 and
+#           1e13 from it, primary and random rays, Mrays/s as a ratio to
+#           each structure's at the origin (best / median / worst of 5
+#           rounds, structures and places taking turns; every 16th ray
+#           against the loop) (bench/raybench.c far; about 50 s)
 #   pov     SPD balls at 512x512, one thread: ./ray against --accel none and
 #           against POV-Ray 3.7; and POV-Ray's other SPD scenes; in rounds,
 #           taking turns
@@ -66,7 +72,8 @@
 # Knobs (environment; with the defaults `make bench` takes about 9 minutes of
 # CPU on the 2-core development machine, 11 of wall clock beside other work;
 # 11 and 18 when it renders anew the references it keeps between runs):
-#   BENCH_PARTS="render spd build rays accel anim pov pt"
+#   BENCH_PARTS="render spd build rays accel anim far pov pt"
+#   BENCH_FAR_RES=256 BENCH_FAR_N=65536   the far section's primary rays a side, and random rays
 #   BENCH_ROUNDS=3           rounds of turns between programs (ours and Embree
 #                            in the accel section, ours and POV-Ray, kd and
 #                            none, the animation's)
@@ -125,7 +132,7 @@ FLAKE_SIZE=${BENCH_FLAKE_SIZE:-}
 FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
-PARTS=${BENCH_PARTS:-render spd build rays accel anim pov pt}
+PARTS=${BENCH_PARTS:-render spd build rays accel anim far pov pt}
 SPD_DIR=${BENCH_SPD_DIR:-scenes/spd}
 POV_DIR=${BENCH_POV_DIR:-../shared/spd/pov}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
@@ -137,6 +144,8 @@ RAYS_RES=${BENCH_RAYS_RES:-1024}
 RAYS_N=${BENCH_RAYS_N:-1000000}
 ROUNDS=${BENCH_ROUNDS:-3}
 RAYS_ROUNDS=${BENCH_RAYS_ROUNDS:-5}
+FAR_RES=${BENCH_FAR_RES:-256}
+FAR_N=${BENCH_FAR_N:-65536}
 OUT=bench/out
 
 die() { echo "bench/run.sh: $*" >&2; exit 1; }
@@ -183,12 +192,12 @@ done
 for n in $SPPS; do
   [ "$n" -lt "$REF_SPP" ] || die "BENCH_REF_SPP ($REF_SPP) must exceed every count in BENCH_SPP ($SPPS)"
 done
-for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N $ROUNDS $RAYS_ROUNDS; do
+for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N $ROUNDS $RAYS_ROUNDS $FAR_RES $FAR_N; do
   case $n in ''|*[!0-9]*|0) die "BENCH_NONE_BUDGET, BENCH_BUILD_MAX, BENCH_RAYS_RES, BENCH_RAYS_N, BENCH_ROUNDS and BENCH_RAYS_ROUNDS must be whole numbers from 1, not '$n'";; esac
 done
 [ "$ROUNDS" -le 9 ] || die "BENCH_ROUNDS must be at most 9 (raybench anim's limit), not $ROUNDS"
 for p in $PARTS; do
-  case $p in render|spd|build|rays|accel|anim|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim pov pt)";; esac
+  case $p in render|spd|build|rays|accel|anim|far|pov|pt) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim far pov pt)";; esac
 done
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT" || die "cannot create $OUT"
@@ -953,6 +962,40 @@ if part anim; then
         status=1
       fi
     done
+  fi
+  echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
+  echo | tee -a "$OUT/bench.txt"
+fi
+
+# ------------------------------------------------- far from the origin
+# Issue 14: every structure within 20% of its speed at the origin (ratio
+# >= 0.8) for the scene moved up to 1e8 and the camera up to 1e13 away.
+if part far; then
+  t_part=$SECONDS
+  echo "Far from the origin (bench/raybench.c far; one thread, CPU time):" | tee -a "$OUT/bench.txt"
+  if [ -z "$RAYBENCH" ]; then
+    echo "bench/raybench.c did not build: skipped" | tee -a "$OUT/bench.txt"
+  elif ! make_mesh sphere100k; then
+    echo "sphere100k: $mesh_why, skipped" | tee -a "$OUT/bench.txt"
+  else
+    say "far: sphere100k"
+    log=$OUT/far-sphere100k.log
+    if "$RAYBENCH" far "$mesh_obj" "$FAR_RES" "$FAR_RES" "$FAR_N" >"$log" 2>&1; then
+      grep -v '^result ' "$log" | tee -a "$OUT/bench.txt"
+      # per structure, the lowest median ratio of any place and ray set
+      worst=$(awk '$1 == "result" && $2 != "far=origin" {
+                     for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
+                     if (!(v["accel"] in w) || v["ratio"] + 0 < w[v["accel"]]) w[v["accel"]] = v["ratio"] + 0
+                     if (v["differ"] + 0) bad = 1 }
+                   END { for (a in w) printf "%s %.2f\n", a, w[a]; if (bad) print "DIFFER 0" }' "$log" | sort)
+      low=$(awk '$1 != "DIFFER" { print $2 }' <<<"$worst" | sort -g | head -n 1)
+      line=$(awk '$1 != "DIFFER" { printf "%s%s %s", n++ ? ", " : "", $1, $2 }' <<<"$worst")
+      grep -q DIFFER <<<"$worst" && { line="$line; answers DIFFER from the loop"; status=1; }
+      targets+=("far from the origin, sphere100k, one thread, CPU time: each structure's lowest ratio of its median Mrays/s (scene at 1e4, 1e6, 1e8; camera at 1e10, 1e13; primary and random rays) to its median at the origin: $line (target >= 0.8): $(verdict "${low:-0} >= 0.8")")
+    else
+      echo "sphere100k: raybench far failed, see $log" | tee -a "$OUT/bench.txt"
+      status=1
+    fi
   fi
   echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
   echo | tee -a "$OUT/bench.txt"

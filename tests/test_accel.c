@@ -144,34 +144,35 @@ static double maxabs3(const double a[3])
 /* Triangle: the three edge tests share their products with the neighbour
  * across each edge (b x c = -(c x b) exactly), so no ray slips between two
  * triangles; hits on edges and vertices count (closed triangles).
- * prims.h asks that the hit point lie within a few eps of the largest
- * coordinate of the triangle's box; from far away (the far checks) the
- * products of the far vectors v - o would cancel and amplify their
- * rounding, so a ray from more than 4096 times the triangle's size away is
- * first moved along itself to the point nearest v0 (t0 is added back).
- * Nearer rays, among them every exact ray of the dyadic scenes, are tested
- * from their own origin. */
+ * prims.h lets a hit from far away err along the ray by a few eps of |o|,
+ * but off it only by a few eps of the triangle's coordinates; the far
+ * vectors v - o are rounded by eps |o|, and their products cancel, so a ray
+ * from more than 4096 times the triangle's size away is first moved along
+ * itself to the point nearest v0, the vectors from there to the corners
+ * summed exactly (prims_along; t0 is added back).  Nearer rays, among them
+ * every exact ray of the dyadic scenes, are tested from their own origin. */
 static int hit_tri(const prim *t, const ray *r, double tmin, double tmax,
                    double *out)
 {
-    double a[3], b[3], c[3], o[3], e[3], w0, w1, w2, den, num, th, t0 = 0;
-    int k;
+    double a[3], b[3], c[3], e[3], w0, w1, w2, den, num, th, t0 = 0;
+    int k, far;
     den = dot(t->n, r->d);
     if (den == 0) return 0;  /* parallel to the plane, or lying in it */
     sub(t->v[0], r->o, a);
     sub(t->v[1], t->v[0], b), sub(t->v[2], t->v[0], e);
-    memcpy(o, r->o, sizeof o);
-    if (maxabs3(a) > 4096 * (maxabs3(b) + maxabs3(e))) {
-        t0 = dot(a, r->d) / dot(r->d, r->d);
-        for (k = 0; k < 3; k++) o[k] = r->o[k] + t0 * r->d[k];
-        sub(t->v[0], o, a);
+    far = maxabs3(a) > 4096 * (maxabs3(b) + maxabs3(e));
+    if (far) t0 = dot(a, r->d) / dot(r->d, r->d);
+    for (k = 0; k < 3 && far; k++) {   /* v - (o + t0 d) */
+        a[k] = -prims_along(r->o[k], t->v[0][k], t0, r->d[k]);
+        b[k] = -prims_along(r->o[k], t->v[1][k], t0, r->d[k]);
+        c[k] = -prims_along(r->o[k], t->v[2][k], t0, r->d[k]);
     }
     num = dot(t->n, a);
-    if (t0 == 0 && tmin >= 0 && !(num > 0 ? den > 0 : num < 0 && den < 0))
+    if (!far && tmin >= 0 && !(num > 0 ? den > 0 : num < 0 && den < 0))
         return 0;  /* t <= 0 <= tmin, known without the division */
     th = t0 + num / den;
     if (!(th > tmin && th <= tmax && th < HUGE_VAL)) return 0;  /* not at infinity */
-    sub(t->v[1], o, b), sub(t->v[2], o, c);
+    if (!far) sub(t->v[1], r->o, b), sub(t->v[2], r->o, c);
     w0 = triple(r->d, b, c), w1 = triple(r->d, c, a), w2 = triple(r->d, a, b);
     if ((w0 < 0 || w1 < 0 || w2 < 0) && (w0 > 0 || w1 > 0 || w2 > 0)) return 0;
     *out = th;
@@ -1058,41 +1059,148 @@ static void check_rays(const accel *A, const scene *s, const prims *p, const voi
     free(sp.axis), free(sp.pos);
 }
 
-/* Rays the fast walks do not take: origins 10^12 scene sizes away, aimed at
- * the scene (the margin outgrows every cell), and directions scaled by
- * 2^-70 or 2^70 (out of the float test's range).  The structures answer
- * them by testing every primitive, or walk them as usual; either way the
- * answer must be brute force's. */
+/* Rays from far away, and rays the fast walks do not take, in turn:
+ * origins 10^13 away aimed at a corner of a primitive (or a sphere's
+ * centre) or at a point on one, where neighbouring primitives are hit at t
+ * that differ by no more than their rounding (10^-3 at 10^13: the walk's
+ * slack along the ray, prims.h, decides these); origins 10^12 scene sizes
+ * away aimed at the scene; and directions scaled by 2^-70 or 2^70 (out of
+ * the float test's range).  The structures answer them by testing every
+ * primitive, or walk them as usual; either way the answer must be brute
+ * force's. */
 static void check_far(const accel *A, const scene *s, const prims *p, const void *t,
                       long nrays)
 {
     box3 b;
-    long k, bad = 0;
-    char msg[200], what[64];
+    long k, bad = 0, hits = 0;
+    char msg[300], what[64];
     scene_box(s, &b);
     for (k = 0; k < nrays; k++) {
         ray r;
-        double target[3], f = k % 3 == 0 ? 0x1p-70 : k % 3 == 1 ? 0x1p70 : 1, tw, tg;
+        double target[3], f = k % 4 == 0 ? 0x1p-70 : k % 4 == 1 ? 0x1p70 : 1, tw, tg;
         int a, want, got;
-        point_in(s, &b, 0, 0, target);
+        if (k % 4 == 3 && s->n > 0) {
+            if (k % 8 == 3) vertex_target(s, target);
+            else point_on(s, irand(s->n), 0, target);
+        } else
+            point_in(s, &b, 0, 0, target);
         random_dir(r.d);
         for (a = 0; a < 3; a++) {
             double size = b.hi[a] - b.lo[a] + 1;
-            r.o[a] = k % 3 == 2 ? target[a] - 1e12 * size * r.d[a] : target[a] - 3 * size * r.d[a];
+            r.o[a] = k % 4 == 3 ? target[a] - 1e13 * r.d[a]
+                     : k % 4 == 2 ? target[a] - 1e12 * size * r.d[a] : target[a] - 3 * size * r.d[a];
             r.d[a] *= f;
         }
         tw = tg = HUGE_VAL;
         want = brute_nearest(s, &r, -1, 0, &tw);
         got = nearest(A, t, p, &r, -1, 0, &tg, NULL);
+        hits += want >= 0;
         if (want != got || memcmp(&tw, &tg, sizeof tw)) {
             bad++;
             show_mismatch("far", GENERAL, &r, 0, HUGE_VAL, "brute", want, tw, A->name, got, tg);
         }
     }
-    sprintf(msg, "%ld rays from 10^12 sizes away or with directions of 2^-70 and 2^70, "
-            "%ld mismatches", nrays, bad);
+    sprintf(msg, "%ld rays from 10^13 away at corners and surfaces, from 10^12 sizes away, "
+            "or with directions of 2^-70 and 2^70; %ld hit, %ld mismatches", nrays, hits, bad);
     sprintf(what, "%s far", A->name);
     report(bad == 0, msg, s->name, what);
+}
+
+/* The scene moved by OFFSET along every axis, built anew and checked as at
+ * the origin on a quarter of the rays, and from far away: a float step of
+ * the caller's coordinates is then 8, larger than the scene, so the
+ * structures' frames and margins must follow the scene's size and not its
+ * distance from the origin.  1e8 is an integer, so the dyadic scenes keep
+ * their exact coordinates (down to 2^-26). */
+#define OFFSET 1e8
+
+/* The work (steps and tests) of nrays rays into the scene, each aimed at a
+ * point of its box from `dist` away (dist < 0: -dist times the box's
+ * size), through structure t, with the scene moved by off. */
+static prim_counters work(const accel *A, const scene *s, const prims *p, const void *t,
+                          long nrays, double dist, double off)
+{
+    prim_counters c = {0, 0, 0};
+    box3 b;
+    double size = 0;
+    long k;
+    int a;
+    unsigned long long keep = rng_state;
+    rng_state = 12345;          /* the same rays every time */
+    scene_box(s, &b);
+    for (a = 0; a < 3; a++) {
+        b.lo[a] -= off, b.hi[a] -= off;
+        size = fmax(size, b.hi[a] - b.lo[a]);
+    }
+    if (dist < 0) dist *= -(size + 1);
+    for (k = 0; k < nrays; k++) {
+        ray r;
+        double target[3], tg = HUGE_VAL;
+        point_in(s, &b, 0, 0, target);
+        random_dir(r.d);
+        for (a = 0; a < 3; a++)
+            r.o[a] = target[a] - dist * r.d[a] + off;
+        nearest(A, t, p, &r, -1, 0, &tg, &c);
+    }
+    rng_state = keep;
+    return c;
+}
+
+/* The structures' work far from the origin against their work at it, on
+ * the same rays: the scene moved by OFFSET, rays from 10^13 away, and
+ * both.  Each must stay within 1.25 times the origin's steps and tests per
+ * ray, plus one: more would mean a margin that grows with the distance
+ * from the origin (the speed issue 14 asked about; exactness alone cannot
+ * show it). */
+static void check_work(const accel *A, const scene *s, const prims *p, const void *t,
+                       const scene *o, const prims *op, const void *ot, long nrays)
+{
+    prim_counters c[4];
+    double steps[4], tests[4];
+    char msg[400], what[64];
+    int j, ok = 1;
+    c[0] = work(A, s, p, t, nrays, -3, 0);
+    c[1] = work(A, o, op, ot, nrays, -3, OFFSET);
+    c[2] = work(A, s, p, t, nrays, 1e13, 0);
+    c[3] = work(A, o, op, ot, nrays, 1e13, OFFSET);
+    for (j = 0; j < 4; j++) {
+        steps[j] = (double)c[j].steps / nrays, tests[j] = (double)c[j].tests / nrays;
+        ok &= steps[j] <= 1.25 * steps[0] + 1 && tests[j] <= 1.25 * tests[0] + 1;
+    }
+    sprintf(msg, "steps and tests per ray on %ld rays: at the origin %.2f and %.2f, the scene "
+            "offset by 1e8 %.2f and %.2f, from 1e13 away %.2f and %.2f, both %.2f and %.2f "
+            "(each within 1.25x the origin's, plus 1)", nrays, steps[0], tests[0], steps[1],
+            tests[1], steps[2], tests[2], steps[3], tests[3]);
+    sprintf(what, "%s work far", A->name);
+    report(ok, msg, s->name, what);
+}
+
+static void check_offset(const accel *A, const scene *s, const prims *sp, const void *st,
+                         long nrays)
+{
+    scene o = *s;
+    prims p;
+    void *t;
+    int i, k, a;
+    o.p = alloc_prims(s->n);
+    for (i = 0; i < s->n; i++) {
+        prim q = s->p[i];
+        for (k = 0; k < (q.kind == TRI ? 3 : 1); k++)
+            for (a = 0; a < 3; a++) q.v[k][a] += OFFSET;
+        o.p[i] = q.kind == TRI ? make_tri(q.v[0], q.v[1], q.v[2]) : q;
+    }
+    p.bounds = bounds, p.clip = o.use_clip ? clip : NULL, p.hit = hit, p.user = &o, p.eps = 0;
+    t = build(A, o.n, &p);
+    if (!t) {
+        report(0, "the build of the scene offset by 1e8 returned NULL", s->name, A->name);
+        free(o.p);
+        return;
+    }
+    check_rays(A, &o, &p, t, nrays / 4, "offset 1e8");
+    check_far(A, &o, &p, t, nrays / 100 + 1);
+    check_work(A, s, sp, st, &o, &p, t, nrays / 100 + 1);
+    release(A, t);
+    free(o.p);
 }
 
 /* ---- refit ------------------------------------------------------------------ */
@@ -1183,7 +1291,7 @@ int main(int argc, char **argv)
                 "soup|mesh|grid|thirds|tenths|same|flat|empty|one [rays]\n");
         return 2;
     }
-    p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s;
+    p.bounds = bounds, p.clip = s.use_clip ? clip : NULL, p.hit = hit, p.user = &s, p.eps = 0;
     t = build(A, s.n, &p);
     if (!t) {
         report(0, "the build returned NULL", s.name, A->name);
@@ -1193,6 +1301,7 @@ int main(int argc, char **argv)
     check_determinism(A, &s, &p, t);
     check_rays(A, &s, &p, t, nrays, "");
     if (strcmp(s.name, "same")) check_far(A, &s, &p, t, nrays / 100 + 1);
+    if (strcmp(s.name, "same")) check_offset(A, &s, &p, t, nrays);
     if (A->kind == BVH_SAH_BUILD || A->kind == BVH_MEDIAN_BUILD) check_refit(A, &s, &p, t, nrays);
     release(A, t);
     free(s.p);

@@ -421,6 +421,113 @@ static void test_tree_matches_loop(const char *accel, int n)
     free_scene(&s);
 }
 
+/* The contract of prims.h, kept by ray.c's hit callback: a sphere, a cone
+ * and triangles of sizes 1e-3 to 1, at the origin and moved to 1e4 and 1e8,
+ * hit by rays from 2 to 1e13 of their sizes away, aimed at their boxes.
+ * For each hit at t: how far across the ray its line passes from the box
+ * (the least growth g of the box that the line meets), in units of
+ * PRIMS_HIT_REL L + PRIMS_HIT_ULPS eps s, and how far along the ray t lies
+ * from the stretch inside the box grown by that allowance (or by g, if
+ * more), in units of eps m, both at most 1 and PRIMS_HIT_ULPS.  Half the
+ * rays aim at the middle of a face of the box, where a sphere touches it.  The line is
+ * taken relative to the box's middle c from the point o + t0 d nearest c,
+ * summed exactly (prims_along), so that the measure itself does not round
+ * by eps m.  Without hit_triangle's far move (FAR_MOVE) the triangles err
+ * along the ray by 49 eps m.  Not in the float build: there (FLT_EPSILON)
+ * a triangle met 10^3 of its sizes away errs along by 27 eps m (its edge
+ * slack of 96 ulps, above hit_triangle), and one cone from 10^10 of its
+ * sizes away across by 2.6e7 allowances (without hit_sphere's and
+ * hit_cone's far moves, spheres and cones by 10^11). */
+static void test_hit_contract(void)
+{
+    static const double offsets[3] = { 0, 1e4, 1e8 }, dists[5] = { 2, 1e3, 1e6, 1e10, 1e13 };
+    double worst_across = 0, worst_along = 0, eps = REAL_EPS;
+    unsigned long long x = 11;
+    long hits = 0, rays = 0;
+    int io, id, k, n, i, a;
+    for (io = 0; io < 3; io++) {
+        Scene s = tri_scene(0);
+        vec off = v3(offsets[io], -offsets[io], offsets[io]);
+        for (k = 0; k < 20; k++) {
+            double size = pow(10, -3 * rnd(&x));
+            vec c = add(off, v3(rnd(&x), rnd(&x), rnd(&x)));
+            add_sphere(&s, c, size * (0.1 + rnd(&x)), 0);
+            add_cone(&s, c, size * rnd(&x), add(c, scale(size, v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x)))),
+                     size * rnd(&x), 0);
+            tri(&s, c, add(c, scale(size, v3(rnd(&x), rnd(&x), 0))), add(c, scale(size, v3(0, rnd(&x), rnd(&x)))));
+        }
+        n = nobj(&s);
+        for (i = 0; i < n; i++)
+            for (id = 0; id < 5; id++)
+                for (k = 0; k < 200; k++) {
+                    double lo[3], hi[3], cen[3], o[3], d[3], q[3], L = 0, sm = 0, m, t, t0, tau;
+                    double ta[3], tb[3], g = 0, G, TA = -HUGE_VAL, TB = HUGE_VAL, dmax = 0, dd = 0, cd = 0;
+                    Ray ry;
+                    Query qu;
+                    int b;
+                    prim_bounds(&s, i, lo, hi);
+                    for (a = 0; a < 3; a++) {
+                        cen[a] = 0.5 * lo[a] + 0.5 * hi[a];
+                        L = fmax(L, hi[a] - lo[a]);
+                        sm = fmax(sm, fmax(fabs(lo[a]), fabs(hi[a])));
+                    }
+                    ry.d = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5));
+                    to3(ry.d, d);
+                    for (a = 0; a < 3; a++)   /* from dist sizes away, at a point of the box grown by 10% */
+                        o[a] = lo[a] + (1.2 * rnd(&x) - 0.1) * (hi[a] - lo[a]) - dists[id] * L * d[a];
+                    if (k % 2) {              /* or at the middle of a face: a sphere touches it there */
+                        b = k / 2 % 3;
+                        for (a = 0; a < 3; a++)
+                            o[a] = (a != b ? cen[a] : k / 6 % 2 ? hi[a] : lo[a]) - dists[id] * L * d[a];
+                    }
+                    ry.o = v3(o[0], o[1], o[2]), ry.skip = -1, ry.tmin = 0;
+                    qu = query(ry);
+                    to3(ry.o, o);
+                    rays++;
+                    if (!prim_hit(&s, i, &qu, 0, INFINITY, &t)) continue;
+                    hits++;
+                    m = sm;
+                    for (a = 0; a < 3; a++) {
+                        m = fmax(m, fabs(o[a]));
+                        dmax = fmax(dmax, fabs(d[a]));
+                        dd += d[a] * d[a], cd += (cen[a] - o[a]) * d[a];
+                    }
+                    t0 = cd / dd;
+                    for (a = 0; a < 3; a++) q[a] = prims_along(o[a], cen[a], t0, d[a]);
+                    tau = t - t0;
+                    /* the line q + tau d against the box lo - c .. hi - c, per axis */
+                    for (a = 0; a < 3; a++) {
+                        double l = lo[a] - cen[a], h = hi[a] - cen[a];
+                        if (d[a] == 0) {
+                            g = fmax(g, fmax(l - q[a], q[a] - h));
+                            ta[a] = -HUGE_VAL, tb[a] = HUGE_VAL;
+                            continue;
+                        }
+                        ta[a] = ((d[a] > 0 ? l : h) - q[a]) / d[a];
+                        tb[a] = ((d[a] > 0 ? h : l) - q[a]) / d[a];
+                    }
+                    for (a = 0; a < 3; a++)
+                        for (b = 0; b < 3; b++)
+                            if (d[a] != 0 && d[b] != 0)
+                                g = fmax(g, (ta[a] - tb[b]) / (1 / fabs(d[a]) + 1 / fabs(d[b])));
+                    G = PRIMS_HIT_REL * L + PRIMS_HIT_ULPS * eps * sm;
+                    worst_across = fmax(worst_across, g / G);
+                    G = fmax(G, g);
+                    for (a = 0; a < 3; a++)
+                        if (d[a] != 0) {
+                            TA = fmax(TA, ta[a] - G / fabs(d[a]));
+                            TB = fmin(TB, tb[a] + G / fabs(d[a]));
+                        }
+                    worst_along = fmax(worst_along, fmax(0, fmax(TA - tau, tau - TB)) * dmax / (eps * m));
+                }
+        free_scene(&s);
+    }
+    report(worst_across <= 1 && worst_along <= PRIMS_HIT_ULPS && hits > rays / 10,
+           "the hit callbacks keep the contract of prims.h (spheres, cones, triangles, at 0, 1e4 and 1e8, "
+           "from 2 to 1e13 sizes away): worst across the ray, in PRIMS_HIT_REL L + PRIMS_HIT_ULPS eps s, "
+           "and along it, in eps m", "%.3g and %.3g", worst_across, worst_along);
+}
+
 /* Whole pixels through the tree and through the loop, shadows and
  * reflections included, must come out bit for bit the same.  The tree's
  * shadow rays try the light's last blocker first (any_hit's shadow cache);
@@ -969,6 +1076,7 @@ int main(void)
     test_watertight(0, 0);
     test_watertight(1, 1e4);
     test_sphere_clip();
+    test_hit_contract();
     test_tree_matches_loop("kd", 1000000);
     test_tree_matches_loop("bvh", 300000);
     test_tree_matches_loop("grid", 300000);
