@@ -1196,7 +1196,7 @@ static void check_offset(const accel *A, const scene *s, const prims *sp, const 
         free(o.p);
         return;
     }
-    check_rays(A, &o, &p, t, nrays / 4, "offset 1e8");
+    check_rays(A, &o, &p, t, nrays / 10, "offset 1e8");
     check_far(A, &o, &p, t, nrays / 100 + 1);
     check_work(A, s, sp, st, &o, &p, t, nrays / 100 + 1);
     release(A, t);
