@@ -957,7 +957,10 @@ bvh *bvh_build(int n, const prims *p, int method)
     ids = malloc(((size_t)n + 1) * sizeof *ids);
     if (b.ref && b.nodes && ids) {
         double lo[3], hi[3];
-        prims_frame(p, n, lo, hi, b.c);
+        /* the frame's centre from at most about 1024 of the primitives:
+         * any centre near the scene will do, since the margins follow the
+         * boxes the tree ends up with (set_scale) */
+        prims_frame(p, n, n / 1024 + 1, lo, hi, b.c);
         m = gather(&b, n);
         if (m > 0) {
             bvh_box box, cbox;

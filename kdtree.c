@@ -1157,7 +1157,7 @@ static int root_list(kd_builder *b, int n, kd_list *L, kd_box *scene)
     int i, a;
     memset(scene, 0, sizeof *scene);
     if (!alloc_list(L, 2 * (long)n)) return 0;
-    prims_frame(b->p, n, b->wlo, b->whi, b->c);   /* one more call of bounds per primitive */
+    prims_frame(b->p, n, 1, b->wlo, b->whi, b->c);   /* one more call of bounds per primitive */
     for (i = 0; i < n; i++) {
         double lo[3], hi[3];
         kd_box box;

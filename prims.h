@@ -106,8 +106,8 @@ static inline double prims_along(double o, double c, double t, double d)
     return s2 + (e + e2 + pe);
 }
 
-/* The box lo..hi of primitives 0..n-1 (those with a box), and the centre
- * c of a frame for it, for a structure that keeps its planes or boxes as
+/* The box lo..hi of primitives 0, step, 2 step, ... below n (those with a
+ * box; step 1 for all of them), and the centre c of a frame for it, for a structure that keeps its planes or boxes as
  * floats relative to c (kdtree.c, bvh.c): a float step is then 2^-23 of
  * the scene's size wherever the scene lies, where in the caller's
  * coordinates a scene 1e8 from the origin would have steps of 8.  c is the
@@ -117,12 +117,13 @@ static inline double prims_along(double o, double c, double t, double d)
  * scene about the origin gets c = 0 and the very structure it had in the
  * caller's coordinates.  A box of no size (one point) is centred on
  * itself; one that is not finite keeps the origin. */
-static inline void prims_frame(const prims *p, int n, double lo[3], double hi[3], double c[3])
+static inline void prims_frame(const prims *p, int n, int step, double lo[3], double hi[3],
+                               double c[3])
 {
     double side = 0, unit = 0;
     int i, a, e, any = 0;
     for (a = 0; a < 3; a++) lo[a] = hi[a] = 0;
-    for (i = 0; i < n; i++) {
+    for (i = 0; i < n; i += step) {
         double l[3], h[3];
         p->bounds(p->user, i, l, h);
         for (a = 0; a < 3; a++)
