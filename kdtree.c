@@ -97,7 +97,7 @@
  * time O(N log N): each level of the tree, at most 8 + 1.3 log2 N of them,
  * handles at most BUDGET (N + 1) references in linear time (sorting too:
  * see sort_events).  16 leaves every tree of the SPD scenes, the
- * 100k-triangle sphere, the 1M cube-sphere and test_kdtree's scenes as it
+ * 100k-triangle sphere, the 1M cube-sphere and test_accel's scenes as it
  * was (8 changes the flat one, whose tree costs 9.6 a primitive); a
  * 50k-triangle fan then builds in 0.38 s with 0.80M references (8: 0.19 s,
  * 32: 0.78 s). */
