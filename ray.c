@@ -1645,9 +1645,9 @@ static int watertight_inside(vec a, vec b, vec c, const Ray *r)
  * as hit_sphere and hit_cone move theirs; the test is made from there, and
  * the distance moved added to t.  u and v are then exact to the
  * triangle's own rounding, and t to a rounding of itself.  Rays that fall
- * within the 1e-7
- * of an edge still get the exact test from the caller's own origin, which
- * every triangle around the edge shares: the mesh stays watertight.
+ * within the 1e-7 of an edge still get the exact test from the caller's own
+ * origin, which every triangle around the edge shares: the mesh stays
+ * watertight.
  * Nearer rays take the lecture's path unchanged.
  * Returns 1 and t, u, v (barycentrics of v1 and v2) on a hit. */
 static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
