@@ -572,10 +572,13 @@ static void bounds_of(const bvh_builder *b, long first, long n, bvh_box *box,
  * small node's sweep then costs in proportion to it. */
 static int bins_for(long n) { return n < BINS ? (int)n : BINS; }
 
+/* The bin of doubled centroid c.  Compared before it is converted: a
+ * centroid box thinner than a float step makes k1 infinite, and x infinite
+ * or NaN (0 times infinity), which no int can hold. */
 static int bin_of(float c, float lo, float k1, int nb)
 {
-    int i = (int)((c - lo) * k1);
-    return i < 0 ? 0 : i >= nb ? nb - 1 : i;
+    float x = (c - lo) * k1;
+    return !(x >= 1) ? 0 : x >= nb ? nb - 1 : (int)x;
 }
 
 /* nb slabs per axis of the centroid box: 1/width, or 0 for a flat axis
