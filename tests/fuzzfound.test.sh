@@ -36,26 +36,25 @@ refused nan_huge.sph 3 "colours and weights must lie within 1e30"
 refused cone_flat.sph 4 "cone shorter than 1e-9"
 refused cone_flat.min.nff 10 "cone shorter than 1e-9"
 
+# like_loop NAME WHAT: scene NAME.sph renders with every structure as with
+# the loop over every object, the same floats
+like_loop() {
+  local a
+  for a in kd bvh grid; do
+    if ./ray -s 8x8 --accel none -o "$TMP/$1.none.pfm" "$D/$1.sph" 2>"$TMP/err" \
+       && ./ray -s 8x8 --accel $a -o "$TMP/$1.$a.pfm" "$D/$1.sph" 2>>"$TMP/err" \
+       && cmp -s "$TMP/$1.none.pfm" "$TMP/$1.$a.pfm"; then
+      ok "$1: --accel $a renders $2 as the loop does"
+    else
+      bad "$1: --accel $a differs from the loop or fails $(head -c 200 "$TMP/err")"
+    fi
+  done
+}
+
 # grid_face: flat triangles on the scene box's far side, lost by the grid
-for a in kd bvh grid; do
-  if ./ray -s 8x8 --accel none -o "$TMP/none.pfm" "$D/grid_face.sph" 2>"$TMP/err" \
-     && ./ray -s 8x8 --accel $a -o "$TMP/$a.pfm" "$D/grid_face.sph" 2>>"$TMP/err" \
-     && cmp -s "$TMP/none.pfm" "$TMP/$a.pfm"; then
-    ok "grid_face: --accel $a renders the triangles on the box's far side as the loop does"
-  else
-    bad "grid_face: --accel $a differs from the loop $(head -c 200 "$TMP/err")"
-  fi
-done
+like_loop grid_face "the triangles on the box's far side"
 
 # bvh_thin: a centroid box thinner than a float step made bvh.c's bin index
 # infinite, converted to int (undefined; UBSan stops it in CI's sanitizer run
-# of make test); every structure must render it as the loop does
-for a in kd bvh grid; do
-  if ./ray -s 8x8 --accel none -o "$TMP/thin_none.pfm" "$D/bvh_thin.sph" 2>"$TMP/err" \
-     && ./ray -s 8x8 --accel $a -o "$TMP/thin_$a.pfm" "$D/bvh_thin.sph" 2>>"$TMP/err" \
-     && cmp -s "$TMP/thin_none.pfm" "$TMP/thin_$a.pfm"; then
-    ok "bvh_thin: --accel $a renders the thin mesh as the loop does"
-  else
-    bad "bvh_thin: --accel $a differs from the loop or fails $(head -c 200 "$TMP/err")"
-  fi
-done
+# of make test)
+like_loop bvh_thin "the thin mesh"
