@@ -98,13 +98,9 @@
  * another or on the order pixels are computed in.
  */
 
-/* Unix gets a progress line when stderr is a terminal, a wall clock for
- * --stats, and care not to rename over a device given as -o; elsewhere the
- * program is plain C99 and does without. */
-#if defined(__unix__) || defined(__APPLE__)
-#define _POSIX_C_SOURCE 200809L
-#define RAY_POSIX
-#endif
+/* Unix gets a progress line when stderr is a terminal and a wall clock for
+ * --stats (posix.h); elsewhere the program is plain C99 and does without. */
+#include "posix.h"
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -114,13 +110,15 @@
 #include <string.h>
 #include <time.h>
 #ifdef RAY_POSIX
-#include <sys/stat.h>
 #include <unistd.h>
 #endif
 #include "prims.h"
 #include "kdtree.h"
 #include "bvh.h"
 #include "grid.h"
+#include "scene.h"
+#include "image.h"
+#include "cli.h"
 #ifdef _OPENMP
 #include <omp.h>
 #define OMP(directive) _Pragma(#directive)
@@ -237,6 +235,7 @@ enum { BSDF_ONLY, NEE, MIS };
 enum { SPHERE, CONE, TRIANGLE };
 
 static int nobj(const Scene *s) { return s->nsph + s->ncone + s->ntri; }
+static void out_of_memory(void);        /* in the plumbing: says so, and exits */
 
 /* A ray: origin o, direction d, and skip, an object it cannot hit (or -1).
  * A ray leaving a flat triangle, or a sphere outward, never meets that
@@ -285,14 +284,8 @@ typedef struct {
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
 } Worker;
 
-/* The image being made: bytes (for PPM), or floats (for PFM), row by row
- * from the top-left, three channels a pixel. */
-typedef struct {
-    int w, h;
-    unsigned char *bytes;
-    float *floats;
-    int srgb;                 /* bytes: through the sRGB curve */
-} Image;
+/* The image being made (image.h): bytes (for PPM and PNG), or floats (for
+ * PFM), row by row from the top-left, three channels a pixel. */
 
 /* ----------------------------------------------------------------- vectors */
 
@@ -371,6 +364,7 @@ static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
 static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Worker *wk);
+static void prepare_lights(Scene *s);
 static int choose_light(const Scene *s, real u);
 static real light_choice(const Scene *s, int l);
 static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *wi,
@@ -842,6 +836,70 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
     if (any_hit(s, r, dist, &wk->blocker[l % SHADOW_SLOTS], wk)) return v3(0, 0, 0);
     if (!delta && s->estimator == MIS) pdf /= power_heuristic(pdf, bsdf_pdf(b, wo, wi));
     return scale(cosi / pdf, mul(f, Le));
+}
+
+/* Luminance of a linear sRGB colour (ITU-R BT.709 weights). */
+static real luminance(vec c) { return (real)0.2126 * c.x + (real)0.7152 * c.y + (real)0.0722 * c.z; }
+
+/* One more light, of the given power, at the end of the list (room for
+ * it was made by prepare_lights). */
+static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, real power,
+                        double *total)
+{
+    s->emit[s->nemit].type = type;
+    s->emit[s->nemit].obj = obj;
+    s->emit[s->nemit].pos = pos;
+    s->emit[s->nemit].intensity = intensity;
+    *total += power;
+    s->emit_cdf[s->nemit++] = (real)*total;
+    if (obj >= 0) s->emitter[obj] = s->nemit - 1;
+}
+
+/* The path tracer's lights, each with its power, so that sample_light can
+ * choose one in proportion to it: point lights (intensity I: power 4 pi I),
+ * emitting spheres and triangles (radiance Le over area A, each side:
+ * pi Le A).  A background that is not black is the sky, whose power has no
+ * finite measure: it is chosen half the time when there are other lights
+ * (pricing it by a sphere about the scene, as pbrt does, starves a small
+ * lamp on a large floor of shadow rays). */
+static void prepare_lights(Scene *s)
+{
+    double total = 0;
+    int i, k, n = nobj(s);
+    size_t most = (size_t)s->nlight + n + 1;      /* point lights, objects, the sky */
+    s->emitter = malloc(((size_t)n + 1) * sizeof *s->emitter);
+    s->emit = malloc(most * sizeof *s->emit);
+    s->emit_cdf = malloc(most * sizeof *s->emit_cdf);
+    if (!s->emitter || !s->emit || !s->emit_cdf) out_of_memory();
+    s->nemit = 0;
+    for (i = 0; i < n; i++) s->emitter[i] = -1;
+    s->sky = -1;
+    for (i = 0; i < s->nlight; i++)
+        if (s->light[i].sphere < 0)
+            add_emitter(s, POINT_LIGHT, -1, s->light[i].pos, s->light[i].color,
+                        4 * (real)PI * luminance(s->light[i].color), &total);
+    for (i = 0; i < n; i++) {
+        const Material *m;
+        int what = kind(s, i, &k);
+        real area;
+        if (what == CONE) continue;          /* cones glow but do not light */
+        m = &s->mat[what == SPHERE ? s->sph[k].mat : s->tri[k].mat];
+        if (!(m->kl > 0) || (what == TRIANGLE && s->tri[k].degenerate)) continue;
+        if (what == SPHERE) area = 4 * (real)PI * s->sph[k].rad * s->sph[k].rad;
+        else {
+            vec c = cross(s->tri[k].e1, s->tri[k].e2);
+            area = sqrt(dot(c, c)) / 2 * (s->tri[k].cull ? 1 : 2);
+        }
+        add_emitter(s, what == SPHERE ? SPHERE_LIGHT : TRIANGLE_LIGHT, i, v3(0, 0, 0),
+                    v3(0, 0, 0), (real)PI * m->kl * luminance(m->color) * area, &total);
+    }
+    if (luminance(s->background) > 0) {
+        s->sky = s->nemit;
+        add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), total > 0 ? (real)total : 1,
+                    &total);
+    }
+    for (i = 0; i < s->nemit; i++) s->emit_cdf[i] = total > 0 ? s->emit_cdf[i] / (real)total : 0;
+    if (s->nemit > 0) s->emit_cdf[s->nemit - 1] = 1;
 }
 
 /* The light whose share of the total power holds u, or -1 without lights. */
@@ -1804,19 +1862,6 @@ static int degenerate(vec a, vec b, vec c)
  * NFF) into a Scene, writing the image, the command line and main().
  * ========================================================================= */
 
-/* The plumbing's own headers: characters, signals, opening files (and on
- * Windows, binary mode and the process number). */
-#include <ctype.h>
-#include <signal.h>
-#ifdef RAY_POSIX
-#include <fcntl.h>
-#endif
-#ifdef _WIN32
-#include <fcntl.h>
-#include <io.h>
-#include <process.h>
-#endif
-
 /* ---------------------------------------------------- threads and progress */
 
 typedef struct {
@@ -1969,55 +2014,10 @@ static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
 
 /* ------------------------------------------------------------- scene input */
 
-typedef struct { const char *file; int line; } Where;
-
-/* s on f, with every byte that is not printable ASCII as \xNN: a message
- * that quotes a file never sends a terminal raw binary. */
-static void put_escaped(FILE *f, const char *s)
-{
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c >= 0x20 && c < 0x7F) putc(c, f);
-        else fprintf(f, "\\x%02X", c);
-    }
-}
-
-static int fail(Where w, const char *msg, const char *arg)
-{
-    fprintf(stderr, "%s:%d: %s", w.file, w.line, msg);
-    if (arg) {
-        fputs(": ", stderr);
-        put_escaped(stderr, arg);
-    }
-    fputc('\n', stderr);
-    return 0;
-}
-
-/* One finite number from a token, or a message saying what is wrong. */
-static int number(Where w, const char *tok, real *out)
-{
-    char *end;
-    double v = strtod(tok, &end);
-    if (end == tok || *end) return fail(w, "not a number", tok);
-    if (!isfinite(v)) return fail(w, "number must be finite", tok);
-    *out = (real)v;
-    return 1;
-}
-
-/* The n numbers after tok[first], and nothing else on the line.  `what`
- * names the line's kind for the message. */
-static int numbers(Where w, const char *what, char **tok, int ntok, int first, int n, real *out)
-{
-    int i;
-    char buf[128];
-    if (ntok - first != n) {
-        sprintf(buf, "%.40s needs %d numbers, found %d", what, n, ntok - first);
-        return fail(w, buf, NULL);
-    }
-    for (i = 0; i < n; i++)
-        if (!number(w, tok[first + i], &out[i])) return 0;
-    return 1;
-}
+/* scene.c reads the scene files (the sphere format, OBJ and NFF); what it
+ * reads comes here through the builder (scene.h), whose calls are below:
+ * each makes a Scene's material, primitive, light or setting, or says why
+ * it cannot. */
 
 static void out_of_memory(void)
 {
@@ -2097,142 +2097,6 @@ static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, 
     tr->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
 }
 
-/* Twice the signed area of the 2-D triangle a b c. */
-static double area2(const double *a, const double *b, const double *c)
-{
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-}
-
-/* Is 2-D point p inside or on the triangle a b c (counter-clockwise)? */
-static int inside2(const double *p, const double *a, const double *b, const double *c)
-{
-    return area2(a, b, p) >= 0 && area2(b, c, p) >= 0 && area2(c, a, p) >= 0;
-}
-
-/* A polygon's corners in 2-D, counter-clockwise: it is projected on the
- * plane square to its normal's largest axis (Newell's normal, right for any
- * simple polygon, concave or not). */
-static void flatten(const Scene *s, const int *vi, int n, double (*p)[2])
-{
-    double nn[3] = { 0, 0, 0 }, c[3];
-    int k, ax, ux, vx;
-    for (k = 0; k < n; k++) {
-        vec a = s->vert[vi[k]], b = s->vert[vi[(k + 1) % n]];
-        nn[0] += (a.y - b.y) * (a.z + b.z);
-        nn[1] += (a.z - b.z) * (a.x + b.x);
-        nn[2] += (a.x - b.x) * (a.y + b.y);
-    }
-    ax = largest_axis(nn[0], nn[1], nn[2]);
-    ux = (ax + 1) % 3;            /* (ux, vx, ax) is right-handed: seen from */
-    vx = (ax + 2) % 3;            /* +ax, counter-clockwise is positive area */
-    if (nn[ax] < 0) { k = ux; ux = vx; vx = k; }
-    for (k = 0; k < n; k++) {
-        to3(s->vert[vi[k]], c);
-        p[k][0] = c[ux];
-        p[k][1] = c[vx];
-    }
-}
-
-/* Corner b, between a and c, can be cut off: it turns left, and no corner
- * lies in the triangle a b c.  Only the corners in bent[0..nbent-1], those
- * that do not turn left, are looked at: if any corner lies in the triangle,
- * one of those does (Eberly, "Triangulation by ear clipping", 2002), so the
- * test takes time in proportion to the dents, not to all the corners. */
-static int is_ear(double (*p)[2], const int *bent, int nbent, int a, int b, int c)
-{
-    int j;
-    if (area2(p[a], p[b], p[c]) <= 0) return 0;         /* reflex or flat */
-    for (j = 0; j < nbent; j++) {
-        const double *q = p[bent[j]];
-        if (inside2(q, p[a], p[b], p[c]) && memcmp(q, p[a], sizeof *p)
-            && memcmp(q, p[b], sizeof *p) && memcmp(q, p[c], sizeof *p))
-            return 0;
-    }
-    return 1;
-}
-
-/* The triangle of corners i, j, k of the polygon. */
-static void add_corner_triangle(Scene *s, const int *vi, const int *ni, int i, int j, int k,
-                                int mat)
-{
-    add_triangle(s, vi[i], vi[j], vi[k], ni ? ni[i] : -1, ni ? ni[j] : -1, ni ? ni[k] : -1, mat);
-}
-
-/* Corners a..b of a convex polygon, closed by the edge b-a: the triangle
- * a, m, b with m halfway, then the two arcs it leaves.  Unlike a fan from
- * one corner, no vertex is shared by more than a few triangles, and they
- * shrink towards the rim: a fan of thousands of slivers meeting at a point
- * is the kd-tree's worst case (every cell near the point holds them all). */
-static void triangulate_arc(Scene *s, const int *vi, const int *ni, int a, int b, int mat)
-{
-    int m = a + (b - a) / 2;
-    if (b - a < 2) return;
-    add_corner_triangle(s, vi, ni, a, m, b, mat);
-    triangulate_arc(s, vi, ni, a, m, mat);
-    triangulate_arc(s, vi, ni, m, b, mat);
-}
-
-/* Take corner k off the list bent[0..*nbent-1]; pos[k] is its place there,
- * -1 once it is not listed. */
-static void unlist(int *bent, int *nbent, int *pos, int k)
-{
-    int last = bent[--*nbent];
-    bent[pos[k]] = last, pos[last] = pos[k], pos[k] = -1;
-}
-
-/* Keep corner k listed in bent[] while it does not turn left, between
- * corners prev[k] and next[k]. */
-static void note_bend(double (*p)[2], const int *prev, const int *next, int k, int *bent,
-                      int *nbent, int *pos)
-{
-    int left = area2(p[prev[k]], p[k], p[next[k]]) > 0;
-    if (!left && pos[k] < 0) pos[k] = *nbent, bent[(*nbent)++] = k;
-    if (left && pos[k] >= 0) unlist(bent, nbent, pos, k);
-}
-
-/* A planar polygon, convex or not, as triangles, by ear clipping (Meisters,
- * "Polygons have ears", 1975): some corner can always be cut off, leaving a
- * polygon one corner smaller.  A fan from one corner would be wrong for the
- * gears' concave 144-gons; a convex polygon takes the O(n) way above.
- * The ears are sought going round the polygon, and after each cut the
- * search goes on two corners further, not at the next one: trying the next
- * corner first would cut ears a, c, d then a, d, e and so on, a fan at a
- * (one dent in an 8000-gon put all 7998 triangles at one corner, and the
- * kd-tree took 10 s to build).  Going round, each lap cuts every other
- * corner, as triangulate_arc halves an arc, so a corner ends up in a few
- * triangles per lap and about log2 n laps.  A polygon whose only
- * triangulation is a fan (every corner but one a dent, facing it) still
- * gives one; the kd-tree copes with that too.
- * vi and ni are the corners' vertex and normal indices (ni may be NULL). */
-static void triangulate(Scene *s, const int *vi, const int *ni, int n, int mat)
-{
-    double (*p)[2] = malloc((size_t)n * sizeof *p);
-    int *next = malloc((size_t)n * sizeof *next), *prev = malloc((size_t)n * sizeof *prev);
-    int *bent = malloc((size_t)n * sizeof *bent), *pos = malloc((size_t)n * sizeof *pos);
-    int m = n, k, nbent = 0, convex = 1;
-    if (!p || !next || !prev || !bent || !pos) out_of_memory();
-    flatten(s, vi, n, p);
-    for (k = 0; k < n; k++) next[k] = (k + 1) % n, prev[k] = (k + n - 1) % n, pos[k] = -1;
-    for (k = 0; k < n; k++) {
-        if (area2(p[prev[k]], p[k], p[next[k]]) < 0) convex = 0;
-        note_bend(p, prev, next, k, bent, &nbent, pos);
-    }
-    if (convex) triangulate_arc(s, vi, ni, 0, n - 1, mat);
-    for (k = 0; !convex && m > 2; m--) {
-        int tries, a, c;
-        for (tries = 0; m > 3 && tries < m && !is_ear(p, bent, nbent, prev[k], k, next[k]); tries++)
-            k = next[k];
-        /* tries == m: only flat or self-touching corners are left; cut one anyway */
-        a = prev[k], c = next[k];
-        add_corner_triangle(s, vi, ni, a, k, c, mat);
-        next[a] = c, prev[c] = a;
-        if (pos[k] >= 0) unlist(bent, &nbent, pos, k);  /* cut anyway */
-        note_bend(p, prev, next, a, bent, &nbent, pos);
-        note_bend(p, prev, next, c, bent, &nbent, pos);
-        k = next[c];
-    }
-    free(p), free(next), free(prev), free(bent), free(pos);
-}
 
 static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
 {
@@ -2247,87 +2111,7 @@ static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
     c->mat = mat;
 }
 
-/* bx by bz rb  ax ay az ra: a cone's base and apex, each with its radius. */
-static int check_cone(Scene *s, Where w, const real *x, int mat)
-{
-    vec base = v3(x[0], x[1], x[2]), apex = v3(x[4], x[5], x[6]);
-    if (!(x[3] >= 0 && x[7] >= 0 && x[3] + x[7] > 0))
-        return fail(w, "cone radii must be >= 0 and not both 0", NULL);
-    if (!(dot(sub(apex, base), sub(apex, base)) > 0))
-        return fail(w, "cone base and apex coincide", NULL);
-    /* Shorter than this, the rounding of a point's height along the axis
-     * exceeds the length itself, and the side would be found where it is
-     * not (the fuzz targets found one 1e-71 long, hit at the eye). */
-    if (!(sqrt(dot(sub(apex, base), sub(apex, base)))
-          >= 1e-9 * (fmax(x[3], x[7]) + maxabs(base) + maxabs(apex))))
-        return fail(w, "cone shorter than 1e-9 of its radius and coordinates", NULL);
-    add_cone(s, base, x[3], apex, x[7], mat);
-    return 1;
-}
 
-/* A colour or a weight beyond 1e30 would overflow to infinity in a few
- * products (and infinity times a weight of 0 is NaN), and an index of
- * refraction beyond 1e6 either way makes refract() cancel two huge terms
- * and return a direction that is no unit vector: both are refused (the
- * fuzz targets found NaN pixels from each). */
-#define COLOR_LIMIT 1e30
-static int color_ok(vec c)
-{
-    return fabs(c.x) <= COLOR_LIMIT && fabs(c.y) <= COLOR_LIMIT && fabs(c.z) <= COLOR_LIMIT;
-}
-
-static int material_ok(Where w, const Material *m)
-{
-    if (!(m->ir >= 1e-6 && m->ir <= 1e6))
-        return fail(w, "index of refraction must be between 1e-6 and 1e6", NULL);
-    if (!color_ok(m->color) || !color_ok(v3(m->kd, m->ks, m->kt)) || !(fabs(m->kl) <= COLOR_LIMIT))
-        return fail(w, "colours and weights must lie within 1e30 either way", NULL);
-    return 1;
-}
-
-/* Remembers the first material whose kd + ks + kt exceeds 1, for the path
- * tracer's warning, and the first whose ks + kt does, for Whitted's (its
- * model takes such weights as they are). */
-static void note_weights(Scene *s, Where w, const Material *m)
-{
-    if (m->kd + m->ks + m->kt > 1 && !s->warning[0])
-        sprintf(s->warning, "%.100s:%d: warning: kd + ks + kt = %.3g exceeds 1; "
-                "the path tracer scales them to 1", w.file, w.line, (double)(m->kd + m->ks + m->kt));
-    if (m->ks + m->kt > 1 && !s->whitted_warning[0])
-        sprintf(s->whitted_warning, "%.100s:%d: warning: ks + kt = %.3g exceeds 1: what is "
-                "reflected and refracted grows at every bounce, light out of nothing", w.file, w.line,
-                (double)(m->ks + m->kt));
-}
-
-/* r g b kd ks kt kl ir: minray's material fields, for tri and mesh lines. */
-static int material8(Scene *s, Where w, const real *v, int *mat)
-{
-    Material m;
-    m.color = v3(v[0], v[1], v[2]);
-    m.kd = v[3]; m.ks = v[4]; m.kt = v[5]; m.kl = v[6]; m.ir = v[7]; m.shine = 0;
-    if (!material_ok(w, &m)) return 0;
-    *mat = add_material(s, m);
-    note_weights(s, w, &m);
-    return 1;
-}
-
-
-/* One sphere: minray's 12 numbers in minray's order. */
-static int parse_sphere(Scene *s, Where w, char **tok, int ntok)
-{
-    real v[12];
-    int mat;
-    if (!numbers(w, "a sphere", tok, ntok, 0, 12, v)) return 0;
-    if (!(v[6] > 0)) return fail(w, "sphere radius must be positive", tok[6]);
-    {
-        real m[8];          /* the material: all the fields after the centre but the radius */
-        m[0] = v[3]; m[1] = v[4]; m[2] = v[5];
-        m[3] = v[7]; m[4] = v[8]; m[5] = v[9]; m[6] = v[10]; m[7] = v[11];
-        if (!material8(s, w, m, &mat)) return 0;
-    }
-    add_sphere(s, v3(v[0], v[1], v[2]), v[6], mat);
-    return 1;
-}
 
 /* The largest |coordinate| of a light or the camera: two points within it
  * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
@@ -2359,356 +2143,157 @@ static double narrowest_fov(void)
 }
 
 /* A point light, within FAR_LIMIT. */
-static int point_light(Scene *s, Where w, vec pos, vec color)
+static int point_light(Scene *s, vec pos, vec color, char *why)
 {
-    char msg[128];
     if (!within_far_limit(pos)) {
-        sprintf(msg, "light too far out: beyond %.2g, its squared distance to the scene overflows",
+        sprintf(why, "light too far out: beyond %.2g, its squared distance to the scene overflows",
                 (double)FAR_LIMIT);
-        return fail(w, msg, NULL);
+        return 0;
     }
-    if (!color_ok(color)) return fail(w, "a light's colour must lie within 1e30 either way", NULL);
     add_light(s, pos, color, -1);
     return 1;
 }
 
-static int set_camera(Scene *s, Where w, const real *v)
+/* The camera at eye v[0..2] looking at v[3..5], up towards v[6..8], with a
+ * horizontal field of view of v[9] degrees. */
+static int set_camera(Scene *s, const real *v, char *why)
 {
     Camera *c = &s->cam;
     vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
-    char msg[160];
     c->eye = v3(v[0], v[1], v[2]);
     if (!within_far_limit(c->eye) || !within_far_limit(at)) {
-        sprintf(msg, "camera too far out: beyond %.2g, squared distances from the eye overflow",
+        sprintf(why, "camera too far out: beyond %.2g, squared distances from the eye overflow",
                 (double)FAR_LIMIT);
-        return fail(w, msg, NULL);
+        return 0;
     }
     if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
-        return fail(w, "camera looks at its own eye", NULL);
+        return sprintf(why, "camera looks at its own eye"), 0;
     if (!(v[9] > 0 && v[9] < 180))
-        return fail(w, "field of view must be between 0 and 180 degrees", NULL);
+        return sprintf(why, "field of view must be between 0 and 180 degrees"), 0;
     if (!(v[9] >= narrowest_fov())) {
-        sprintf(msg, "field of view too narrow: under %.2g degrees the image plane is so far away"
+        sprintf(why, "field of view too narrow: under %.2g degrees the image plane is so far away"
                 " that its squared distance overflows", narrowest_fov());
-        return fail(w, msg, NULL);
+        return 0;
     }
     c->tan_half = tan(v[9] * PI / 360);
     c->fwd = unit(pow2_scaled(sub(at, c->eye)));
     c->right = cross(c->fwd, up);
-    if (!(dot(c->right, c->right) > 0)) return fail(w, "camera up is parallel to its view", NULL);
+    if (!(dot(c->right, c->right) > 0)) return sprintf(why, "camera up is parallel to its view"), 0;
     c->right = unit(c->right);
     c->up = cross(c->right, c->fwd);
     return 1;
 }
 
-#define SIZE_RULE "image size must be whole numbers from 1 to 32768, at most 2^28 pixels"
-
-/* 32768 a side and 2^28 pixels: more would not fit a PPM anyone can open and
- * would take hours; a wrong number is far likelier than such a wish. */
-static int check_size(double fw, double fh, int *width, int *height)
+/* A cone from base (radius rb) to apex (radius ra). */
+static int check_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why)
 {
-    if (!(fw >= 1 && fh >= 1 && fw <= 32768 && fh <= 32768 && fw == floor(fw) && fh == floor(fh)
-          && fw * fh <= 268435456.0))
-        return 0;
-    *width = (int)fw;
-    *height = (int)fh;
+    if (!(rb >= 0 && ra >= 0 && rb + ra > 0))
+        return sprintf(why, "cone radii must be >= 0 and not both 0"), 0;
+    if (!(dot(sub(apex, base), sub(apex, base)) > 0))
+        return sprintf(why, "cone base and apex coincide"), 0;
+    /* Shorter than this, the rounding of a point's height along the axis
+     * exceeds the length itself, and the side would be found where it is
+     * not (the fuzz targets found one 1e-71 long, hit at the eye). */
+    if (!(sqrt(dot(sub(apex, base), sub(apex, base))) >= 1e-9 * (fmax(rb, ra) + maxabs(base) + maxabs(apex))))
+        return sprintf(why, "cone shorter than 1e-9 of its radius and coordinates"), 0;
+    add_cone(s, base, rb, apex, ra, mat);
     return 1;
 }
 
-static int blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+/* The builder's calls (scene.h): what scene.c read, into the Scene. */
+static vec vec_of(const double *p) { return v3((real)p[0], (real)p[1], (real)p[2]); }
 
-/* Splits a line in place into at most max blank-separated tokens; '#'
- * starts a comment.  Returns max + 1 when there are more. */
-static int tokens(char *line, char **tok, int max)
+static int build_material(void *user, const scene_material *m, char *why)
 {
-    int n = 0;
-    char *p = line;
-    for (;;) {
-        while (blank(*p)) p++;
-        if (!*p || *p == '#') return n;
-        if (n == max) return max + 1;
-        tok[n++] = p;
-        while (*p && *p != '#' && !blank(*p)) p++;
-        if (*p == '#') { *p = 0; return n; }
-        if (*p) *p++ = 0;
-    }
+    Material k;
+    (void)why;
+    k.color = vec_of(m->color);
+    k.kd = (real)m->kd; k.ks = (real)m->ks; k.kt = (real)m->kt; k.kl = (real)m->kl;
+    k.ir = (real)m->ir; k.shine = (real)m->shine;
+    return add_material(user, k);
 }
 
-#define BOM "\xEF\xBB\xBF"          /* UTF-8's byte order mark, which some editors write */
-
-/* Reads the next line of f into line, without its end: "\n", "\r\n" or a
- * lone "\r" (old Mac files) each end a line.  A byte order mark before the
- * first line is skipped.  0 at the end of the file, or after a message
- * (*ok cleared) on an over-long line or a NUL byte, which no text has. */
-static int next_line(FILE *f, char *line, int size, Where *w, int *ok)
+static int build_sphere(void *user, const double c[3], double r, int mat, char *why)
 {
-    int c = getc(f), n = 0;
-    if (c == EOF) return 0;
-    w->line++;
-    for (; c != EOF && c != '\n' && c != '\r'; c = getc(f)) {
-        if (c == 0) return *ok = fail(*w, "NUL byte: this is not a text file", NULL);
-        if (n == size - 1) {
-            char msg[64];
-            sprintf(msg, "line longer than %d characters", size - 1);
-            return *ok = fail(*w, msg, NULL);
-        }
-        line[n++] = (char)c;
-    }
-    if (c == '\r' && (c = getc(f)) != '\n' && c != EOF) ungetc(c, f);
-    line[n] = 0;
-    if (w->line == 1 && !strncmp(line, BOM, 3)) memmove(line, line + 3, (size_t)n - 2);
+    (void)why;
+    add_sphere(user, vec_of(c), (real)r, mat);
     return 1;
 }
 
-/* An OBJ face corner "v", "v/t", "v//n" or "v/t/n"; indices count from 1,
- * or back from the newest when negative.  *n is -1 without a normal. */
-static int obj_corner(Where w, char *c, int nv, int nn, int *v, int *n)
+static int build_cone(void *user, const double base[3], double rb, const double apex[3], double ra,
+                      int mat, char *why)
 {
-    char *end, *slash;
-    long i = strtol(c, &end, 10);
-    if (end == c || (*end && *end != '/')) return fail(w, "bad face corner", c);
-    if (i < 0) i += nv + 1;
-    if (i < 1 || i > nv) return fail(w, "vertex index out of range", c);
-    *v = (int)i - 1;
-    *n = -1;
-    slash = strchr(c, '/');
-    if (slash && (slash = strchr(slash + 1, '/')) && slash[1]) {
-        i = strtol(slash + 1, &end, 10);
-        if (end == slash + 1 || *end) return fail(w, "bad face corner", c);
-        if (i < 0) i += nn + 1;
-        if (i < 1 || i > nn) return fail(w, "normal index out of range", c);
-        *n = (int)i - 1;
-    }
-    return 1;
+    return check_cone(user, vec_of(base), (real)rb, vec_of(apex), (real)ra, mat, why);
 }
 
-#ifdef RAY_POSIX
-/* A mesh that a scene names must be a plain file: a directory has no
- * lines, and a pipe or a terminal would wait for input for ever.  (Not
- * found: fopen says so.) */
-static int plain_file(const char *name)
-{
-    struct stat st;
-    return stat(name, &st) != 0 || S_ISREG(st.st_mode);
-}
-#else
-static int plain_file(const char *name) { (void)name; return 1; }
-#endif
+static int build_vertex(void *user, const double p[3]) { return add_vertex(user, vec_of(p)); }
+static int build_normal(void *user, const double n[3]) { return add_normal(user, vec_of(n)); }
+static void build_vertex_at(void *user, int i, double p[3]) { to3(((Scene *)user)->vert[i], p); }
 
-/* Wavefront OBJ: v, vn and f (any number of corners); every other statement
- * is skipped with one warning for the file.  `from` is the scene line that
- * asked for it, for the message when it cannot be opened. */
-#define OBJ_LINE 65536                  /* room for faces of thousands of corners */
-
-static int load_obj(Scene *s, const char *file, int mat, Where from)
+static void build_triangle(void *user, const int v[3], const int n[3], int mat)
 {
-    int max = OBJ_LINE / 2, v0 = s->nvert, n0 = s->nnorm, ok = 1, skipped = 0, skipped_line = 0;
-    char *line = malloc(OBJ_LINE), **tok = malloc(sizeof *tok * (max + 1)), first_skipped[32] = "";
-    int *vi = malloc(sizeof *vi * max), *ni = malloc(sizeof *ni * max);
-    Where w;
-    int plain = plain_file(file);
-    FILE *f = plain ? fopen(file, "r") : NULL;
-    if (!line || !tok || !vi || !ni) out_of_memory();
-    if (!plain) ok = fail(from, "mesh is not a plain file (a directory, device or pipe)", file);
-    else if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
-    w.file = file;
-    w.line = 0;
-    while (ok && next_line(f, line, OBJ_LINE, &w, &ok)) {
-        int n = tokens(line, tok, max), k, with_normals = 1;
-        real x[3];
-        if (n == 0) continue;
-        if (n > max) ok = fail(w, "too many fields", NULL);
-        else if (!strcmp(tok[0], "v") || !strcmp(tok[0], "vn")) {
-            int normal = tok[0][1] == 'n';
-            /* a vertex may go on with w, or with a colour: both unused */
-            ok = numbers(w, tok[0], tok, normal || n < 4 ? n : 4, 1, 3, x);
-            if (ok && normal) add_normal(s, v3(x[0], x[1], x[2]));
-            if (ok && !normal) add_vertex(s, v3(x[0], x[1], x[2]));
-        } else if (!strcmp(tok[0], "f")) {
-            if (n < 4) ok = fail(w, "a face needs 3 corners or more", NULL);
-            for (k = 1; k < n && ok; k++) {
-                ok = obj_corner(w, tok[k], s->nvert - v0, s->nnorm - n0, &vi[k - 1], &ni[k - 1]);
-                vi[k - 1] += v0;
-                if (ni[k - 1] < 0) with_normals = 0;
-                else ni[k - 1] += n0;
-            }
-            if (ok) triangulate(s, vi, with_normals ? ni : NULL, n - 1, mat);
-        } else if (!skipped++) {
-            skipped_line = w.line;
-            sprintf(first_skipped, "%.20s", tok[0]);
-        }
-    }
-    if (ok && ferror(f)) ok = fail(w, "cannot read mesh", strerror(errno)); /* mesh . */
-    if (f) fclose(f);
-    if (ok && skipped) {
-        fprintf(stderr, "%s:%d: warning: skipped %d statement%s that are not v, vn or f"
-                " (the first: ", file, skipped_line, skipped, skipped == 1 ? "" : "s");
-        put_escaped(stderr, first_skipped);
-        fputs(")\n", stderr);
-    }
-    free(line); free(tok); free(vi); free(ni);
-    return ok;
+    add_triangle(user, v[0], v[1], v[2], n[0], n[1], n[2], mat);
 }
 
-/* Windows paths separate directories with \ as well as /, and may start
- * with a drive ("C:"); elsewhere \ and : are ordinary characters of a file
- * name.  -DRAY_DOS_PATHS gives the Windows rule anywhere, for the tests. */
-#if defined(_WIN32) && !defined(RAY_DOS_PATHS)
-#define RAY_DOS_PATHS
-#endif
-
-static int path_separator(int c)
+static int build_light(void *user, const double pos[3], const double color[3], char *why)
 {
-#ifdef RAY_DOS_PATHS
-    return c == '/' || c == '\\' || c == ':';
-#else
-    return c == '/';
-#endif
+    return point_light(user, vec_of(pos), vec_of(color), why);
 }
 
-/* Where the file's own name starts in path: after the last separator. */
-static const char *file_part(const char *path)
+static int build_camera(void *user, const double v[10], char *why)
 {
-    const char *p, *name = path;
-    for (p = path; *p; p++)
-        if (path_separator(*p)) name = p + 1;
-    return name;
+    real r[10];
+    int i;
+    for (i = 0; i < 10; i++) r[i] = (real)v[i];
+    return set_camera(user, r, why);
 }
 
-/* A path from the root (or a drive), which no directory may prefix. */
-static int absolute(const char *path)
+static void build_setting(void *user, int what, const double *v, const char *word)
 {
-#ifdef RAY_DOS_PATHS
-    if (path[0] && path[1] == ':') return 1;
-#endif
-    return path_separator(path[0]);
+    Scene *s = user;
+    int i;
+    switch (what) {
+    case SET_SIZE: s->w = (int)v[0]; s->h = (int)v[1]; break;
+    case SET_DEPTH: s->depth = s->max_rays = (int)v[0]; break;
+    case SET_SAMPLES: s->spp = (int)v[0]; break;
+    case SET_HITHER: s->cam.hither = (real)v[0]; break;
+    case SET_TIR_REFLECT: s->tir_reflect = v[0] != 0; break;
+    case SET_PATH: s->integrator = v[0] != 0 ? PATH : WHITTED; break;
+    case SET_AMBIENT: s->ambient = vec_of(v); break;
+    case SET_BACKGROUND: s->background = vec_of(v); break;
+    case SET_PIXEL_CORNER: s->cam.anchor = v[0] != 0 ? 0 : (real)0.5; break;
+    case SET_ONE_SIDED: s->cull = v[0] != 0; break;
+    case SET_LIGHT_SCALE:
+        for (i = 0; i < s->nlight; i++) s->light[i].color = scale((real)v[0], s->light[i].color);
+        break;
+    case SET_ACCEL: s->accel_line = word; break;
+    }
 }
 
-/* A path named in a scene is relative to the scene's directory. */
-static char *beside(const char *scene, const char *name)
+/* The first warning of each kind is kept, to be said when that renderer
+ * starts. */
+static void build_warning(void *user, int path, const char *text)
 {
-    size_t dir = absolute(name) ? 0 : (size_t)(file_part(scene) - scene);
-    char *p = malloc(dir + strlen(name) + 1);
-    if (!p) out_of_memory();
-    memcpy(p, scene, dir);
-    strcpy(p + dir, name);
-    return p;
+    Scene *s = user;
+    char *to = path ? s->warning : s->whitted_warning;
+    if (!to[0]) sprintf(to, "%.255s", text);
 }
 
-/* The structures --accel and a scene's `accel` line name (see build_accel):
- * the name as a string that lasts, or NULL for an unknown one. */
-static const char *accel_name(const char *name)
+static scene_builder builder(Scene *s)
 {
-    static const char *const names[] = { "kd", "bvh", "grid", "none", "auto" };
-    size_t i;
-    for (i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (!strcmp(name, names[i])) return names[i];
-    return NULL;
-}
-
-/* A keyword line: ray.c's extensions to minray's format. */
-static int parse_keyword(Scene *s, Where w, char **tok, int ntok)
-{
-    real v[17];
-    const char *k = tok[0];
-    int mat, ok;
-    if (!strcmp(k, "accel")) {
-        if (ntok != 2 || !accel_name(tok[1]))
-            return fail(w, "expected `accel` and one of kd, bvh, grid, none, auto", NULL);
-        s->accel_line = accel_name(tok[1]);
-        return 1;
-    }
-    if (!strcmp(k, "size"))
-        return numbers(w, k, tok, ntok, 1, 2, v)
-               && (check_size(v[0], v[1], &s->w, &s->h) || fail(w, SIZE_RULE, NULL));
-    if (!strcmp(k, "depth")) {
-        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 1 && v[0] <= 64 && v[0] == floor(v[0])))
-            return fail(w, "depth must be a whole number from 1 to 64", tok[1]);
-        s->depth = s->max_rays = (int)v[0];
-        return 1;
-    }
-    if (!strcmp(k, "samples")) {
-        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 1 && v[0] <= 1 << 20 && v[0] == floor(v[0])))
-            return fail(w, "samples must be a whole number from 1 to 1048576", tok[1]);
-        s->spp = (int)v[0];
-        return 1;
-    }
-    if (!strcmp(k, "hither")) {
-        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 0)) return fail(w, "hither must be 0 or more", tok[1]);
-        s->cam.hither = v[0];
-        return 1;
-    }
-    if (!strcmp(k, "tir")) {
-        if (ntok != 2 || (strcmp(tok[1], "reflect") && strcmp(tok[1], "black")))
-            return fail(w, "expected `tir reflect` or `tir black`", NULL);
-        s->tir_reflect = !strcmp(tok[1], "reflect");
-        return 1;
-    }
-    if (!strcmp(k, "integrator")) {
-        if (ntok != 2 || (strcmp(tok[1], "path") && strcmp(tok[1], "whitted")))
-            return fail(w, "expected `integrator path` or `integrator whitted`", NULL);
-        s->integrator = !strcmp(tok[1], "path") ? PATH : WHITTED;
-        return 1;
-    }
-    if (!strcmp(k, "ambient")) {
-        if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
-        s->ambient = v3(v[0], v[1], v[2]);
-        return 1;
-    }
-    if (!strcmp(k, "background")) {
-        if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
-        s->background = v3(v[0], v[1], v[2]);
-        return 1;
-    }
-    if (!strcmp(k, "camera"))
-        return numbers(w, k, tok, ntok, 1, 10, v) && set_camera(s, w, v);
-    if (!strcmp(k, "light"))
-        return numbers(w, k, tok, ntok, 1, 6, v)
-               && point_light(s, w, v3(v[0], v[1], v[2]), v3(v[3], v[4], v[5]));
-    if (!strcmp(k, "pixel")) {
-        if (ntok != 2
-            || (strcmp(tok[1], "corner") && strcmp(tok[1], "centre") && strcmp(tok[1], "center")))
-            return fail(w, "expected `pixel corner` or `pixel centre`", NULL);
-        s->cam.anchor = !strcmp(tok[1], "corner") ? 0 : (real)0.5;
-        return 1;
-    }
-    if (!strcmp(k, "sided")) {
-        if (ntok != 2 || (strcmp(tok[1], "1") && strcmp(tok[1], "2")))
-            return fail(w, "expected `sided 1` (front faces only) or `sided 2`", NULL);
-        s->cull = tok[1][0] == '1';
-        return 1;
-    }
-    if (!strcmp(k, "tri")) {
-        int a, b;
-        if (!numbers(w, k, tok, ntok, 1, 17, v) || !material8(s, w, v + 9, &mat)) return 0;
-        a = add_vertex(s, v3(v[0], v[1], v[2]));
-        b = add_vertex(s, v3(v[3], v[4], v[5]));
-        add_triangle(s, a, b, add_vertex(s, v3(v[6], v[7], v[8])), -1, -1, -1, mat);
-        return 1;
-    }
-    if (!strcmp(k, "cone")) {
-        if (!numbers(w, k, tok, ntok, 1, 16, v) || !material8(s, w, v + 8, &mat)) return 0;
-        return check_cone(s, w, v, mat);
-    }
-    if (!strcmp(k, "mesh")) {
-        char *path;
-        if (ntok < 2) return fail(w, "mesh needs a file name and 8 numbers", NULL);
-        if (!numbers(w, k, tok, ntok, 2, 8, v) || !material8(s, w, v, &mat)) return 0;
-        path = beside(w.file, tok[1]);
-        ok = load_obj(s, path, mat, w);
-        free(path);
-        return ok;
-    }
-    return fail(w, "unknown keyword", k);
+    static const scene_builder calls = { NULL, build_material, build_sphere, build_cone,
+                                         build_vertex, build_normal, build_vertex_at,
+                                         build_triangle, build_light, build_camera,
+                                         build_setting, build_warning };
+    scene_builder b = calls;
+    b.user = s;
+    return b;
 }
 
 static void default_scene(Scene *s)
 {
     real v[10] = { 0, 0, 0, 0, 1, 0, 0, 0, 1, 45 };
-    Where nowhere = { "", 0 };
+    char why[SCENE_WHY];
     memset(s, 0, sizeof *s);
     s->w = s->h = 512;
     s->depth = 5;
@@ -2717,889 +2302,18 @@ static void default_scene(Scene *s)
     s->estimator = MIS;
     s->roulette = 1;
     s->sky = -1;
-    set_camera(s, nowhere, v);
+    set_camera(s, v, why);
 }
 
-/* Luminance of a linear sRGB colour (ITU-R BT.709 weights). */
-static real luminance(vec c) { return (real)0.2126 * c.x + (real)0.7152 * c.y + (real)0.0722 * c.z; }
 
-static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, real power,
-                        double *total, int *cap)
-{
-    s->emit = grow(s->emit, cap, s->nemit + 1, sizeof *s->emit);
-    s->emit_cdf = realloc(s->emit_cdf, (size_t)*cap * sizeof *s->emit_cdf);
-    if (!s->emit_cdf) out_of_memory();
-    s->emit[s->nemit].type = type;
-    s->emit[s->nemit].obj = obj;
-    s->emit[s->nemit].pos = pos;
-    s->emit[s->nemit].intensity = intensity;
-    *total += power;
-    s->emit_cdf[s->nemit++] = (real)*total;
-    if (obj >= 0) s->emitter[obj] = s->nemit - 1;
-}
-
-/* The path tracer's lights, each with its power, so that sample_light can
- * choose one in proportion to it: point lights (intensity I: power 4 pi I),
- * emitting spheres and triangles (radiance Le over area A, each side:
- * pi Le A).  A background that is not black is the sky, whose power has no
- * finite measure: it is chosen half the time when there are other lights
- * (pricing it by a sphere about the scene, as pbrt does, starves a small
- * lamp on a large floor of shadow rays). */
-static void prepare_lights(Scene *s)
-{
-    double total = 0;
-    int i, k, cap = 0, n = nobj(s);
-    s->emitter = malloc(((size_t)n + 1) * sizeof *s->emitter);
-    if (!s->emitter) out_of_memory();
-    for (i = 0; i < n; i++) s->emitter[i] = -1;
-    s->sky = -1;
-    for (i = 0; i < s->nlight; i++)
-        if (s->light[i].sphere < 0)
-            add_emitter(s, POINT_LIGHT, -1, s->light[i].pos, s->light[i].color,
-                        4 * (real)PI * luminance(s->light[i].color), &total, &cap);
-    for (i = 0; i < n; i++) {
-        const Material *m;
-        int what = kind(s, i, &k);
-        real area;
-        if (what == CONE) continue;          /* cones glow but do not light */
-        m = &s->mat[what == SPHERE ? s->sph[k].mat : s->tri[k].mat];
-        if (!(m->kl > 0) || (what == TRIANGLE && s->tri[k].degenerate)) continue;
-        if (what == SPHERE) area = 4 * (real)PI * s->sph[k].rad * s->sph[k].rad;
-        else {
-            vec c = cross(s->tri[k].e1, s->tri[k].e2);
-            area = sqrt(dot(c, c)) / 2 * (s->tri[k].cull ? 1 : 2);
-        }
-        add_emitter(s, what == SPHERE ? SPHERE_LIGHT : TRIANGLE_LIGHT, i, v3(0, 0, 0),
-                    v3(0, 0, 0), (real)PI * m->kl * luminance(m->color) * area, &total, &cap);
-    }
-    if (luminance(s->background) > 0) {
-        s->sky = s->nemit;
-        add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), total > 0 ? (real)total : 1,
-                    &total, &cap);
-    }
-    for (i = 0; i < s->nemit; i++) s->emit_cdf[i] = total > 0 ? s->emit_cdf[i] / (real)total : 0;
-    if (s->nemit > 0) s->emit_cdf[s->nemit - 1] = 1;
-}
-
-/* The sphere format: a line of numbers is a sphere, a line that starts with
- * a word is a keyword. */
-static int load_sph(Scene *s, FILE *f, Where w)
-{
-    char line[4096], *tok[24];
-    int ok = 1;
-    while (ok && next_line(f, line, sizeof line, &w, &ok)) {
-        int n = tokens(line, tok, 23);
-        if (n > 23) ok = fail(w, "too many fields", NULL);
-        else if (n == 0) continue;
-        else if (strchr("+-.0123456789", tok[0][0])) ok = parse_sphere(s, w, tok, n);
-        else ok = parse_keyword(s, w, tok, n);
-    }
-    return ok;
-}
-
-/* ---------- NFF, Eric Haines' Neutral File Format (the SPD scenes' format) */
-
-/* NFF is a stream of blank-separated tokens, not of lines (a cone's eight
- * numbers may sit on one line or three), so it is read a token at a time.
- * `again` hands the last token out once more, for a look ahead. */
-typedef struct { FILE *f; Where w; int c, prev, again; char tok[256]; } Lexer;
-
-/* On to the next character, counting lines: "\n", "\r\n" and a lone
- * "\r" each end one. */
-static void advance(Lexer *lx)
-{
-    if (lx->c == '\r' || (lx->c == '\n' && lx->prev != '\r')) lx->w.line++;
-    lx->prev = lx->c;
-    lx->c = getc(lx->f);
-}
-
-/* The next token into lx->tok: 1, or 0 at the end of the file, or -1 after
- * saying what is wrong. */
-static int next_token(Lexer *lx)
-{
-    int n = 0;
-    if (lx->again) { lx->again = 0; return 1; }
-    for (;;) {
-        while (blank(lx->c)) advance(lx);
-        if (lx->c != '#') break;
-        while (lx->c != '\n' && lx->c != '\r' && lx->c != EOF && lx->c != 0) advance(lx);
-    }
-    for (; lx->c != EOF && !blank(lx->c); advance(lx)) {
-        if (lx->c == 0) {
-            fail(lx->w, "NUL byte: this is not a text file", NULL);
-            return -1;
-        }
-        if (n == (int)sizeof lx->tok - 1) {
-            fail(lx->w, "token longer than 255 characters", NULL);
-            return -1;
-        }
-        lx->tok[n++] = (char)lx->c;
-    }
-    lx->tok[n] = 0;
-    return n > 0;
-}
-
-/* n numbers in a row, after `what`. */
-static int nff_numbers(Lexer *lx, const char *what, int n, real *out)
-{
-    int i;
-    for (i = 0; i < n; i++) {
-        int got = next_token(lx);
-        if (got == 0) return fail(lx->w, "the file ends inside", what);
-        if (got < 0 || !number(lx->w, lx->tok, &out[i])) return 0;
-    }
-    return 1;
-}
-
-/* The view block: from, at, up, angle, hither, resolution, each once.  NFF's
- * angle spans the centres of the outer pixels, (W-1) pixels, where ours
- * spans the edges, W pixels. */
-static int nff_view(Scene *s, Lexer *lx)
-{
-    static const char *const names[6] = { "from", "at", "up", "angle", "hither", "resolution" };
-    static const int counts[6] = { 3, 3, 3, 1, 1, 2 };
-    real x[6][3], v[10];
-    int seen = 0, k, got = 1;
-    while (seen != 63 && (got = next_token(lx)) > 0) {
-        for (k = 0; k < 6 && strcmp(lx->tok, names[k]); k++) continue;
-        if (k == 6)
-            return fail(lx->w, "expected from, at, up, angle, hither or resolution", lx->tok);
-        if (seen & 1 << k) return fail(lx->w, "said twice in the view block", names[k]);
-        seen |= 1 << k;
-        if (!nff_numbers(lx, names[k], counts[k], x[k])) return 0;
-    }
-    if (got < 0) return 0;
-    if (seen != 63)
-        return fail(lx->w, "the view block needs from, at, up, angle, hither and resolution", NULL);
-    if (!check_size(x[5][0], x[5][1], &s->w, &s->h)) return fail(lx->w, SIZE_RULE, NULL);
-    if (!(x[3][0] > 0 && x[3][0] < 180))
-        return fail(lx->w, "view angle must be between 0 and 180 degrees", NULL);
-    for (k = 0; k < 9; k++) v[k] = x[k / 3][k % 3];   /* from, at, up */
-    if (x[4][0] > 0) s->cam.hither = x[4][0];
-    v[9] = 2 * atan(tan(x[3][0] * PI / 360) * s->w / (s->w > 1 ? s->w - 1 : 1)) * 180 / PI;
-    return set_camera(s, lx->w, v);
-}
-
-/* A polygon of n corners, with a normal at each (pp) or not (p). */
-static int nff_polygon(Scene *s, Lexer *lx, int normals, int mat)
-{
-    real x[6], cnt;
-    int n, k, *vi, *ni, ok = 1;
-    if (!nff_numbers(lx, normals ? "pp" : "p", 1, &cnt)) return 0;
-    if (!(cnt >= 3 && cnt <= 1e6 && cnt == floor(cnt)))
-        return fail(lx->w, "a polygon needs from 3 to 1000000 corners", lx->tok);
-    n = (int)cnt;
-    vi = malloc((size_t)n * sizeof *vi);
-    ni = malloc((size_t)n * sizeof *ni);
-    if (!vi || !ni) out_of_memory();
-    for (k = 0; k < n && ok; k++) {
-        ok = nff_numbers(lx, "a polygon", normals ? 6 : 3, x);
-        if (!ok) break;
-        vi[k] = add_vertex(s, v3(x[0], x[1], x[2]));
-        if (normals) ni[k] = add_normal(s, v3(x[3], x[4], x[5]));
-    }
-    if (ok) triangulate(s, vi, normals ? ni : NULL, n, mat);
-    free(vi);
-    free(ni);
-    return ok;
-}
-
-/* l x y z [r g b]: a point light, white unless a colour follows. */
-static int nff_light(Scene *s, Lexer *lx)
-{
-    real x[3], rgb[3] = { 1, 1, 1 };
-    int got;
-    Where at;
-    if (!nff_numbers(lx, "l", 3, x)) return 0;
-    at = lx->w;                              /* before the look ahead */
-    got = next_token(lx);                    /* a colour, or the next entity */
-    if (got < 0) return 0;
-    lx->again = got > 0;
-    if (got > 0 && strchr("+-.0123456789", lx->tok[0]) && !nff_numbers(lx, "l", 3, rgb)) return 0;
-    return point_light(s, at, v3(x[0], x[1], x[2]), v3(rgb[0], rgb[1], rgb[2]));
-}
-
-/* b r g b: the colour of rays that hit nothing. */
-static int nff_background(Scene *s, Lexer *lx)
-{
-    real x[3];
-    if (!nff_numbers(lx, "b", 3, x)) return 0;
-    s->background = v3(x[0], x[1], x[2]);
-    return 1;
-}
-
-/* f r g b Kd Ks Shine T ior: the material of all that follows. */
-static int nff_material(Scene *s, Lexer *lx, int *mat)
-{
-    real x[8];
-    Material m;
-    if (!nff_numbers(lx, "f", 8, x)) return 0;
-    m.color = v3(x[0], x[1], x[2]);
-    m.kd = x[3]; m.ks = x[4]; m.shine = x[5]; m.kt = x[6]; m.kl = 0;
-    m.ir = x[7] > 0 ? x[7] : 1;  /* the SPD files write 0 for opaque materials */
-    if (!material_ok(lx->w, &m)) return 0;
-    *mat = add_material(s, m);
-    note_weights(s, lx->w, &m);
-    return 1;
-}
-
-static int nff_sphere(Scene *s, Lexer *lx, int mat)
-{
-    real x[4];
-    if (!nff_numbers(lx, "s", 4, x)) return 0;
-    /* In NFF (the SPD's NFF.TXT) a negative radius means a sphere seen
-     * only from inside; objects are otherwise one-sided, seen from outside.
-     * ray.c draws both sides of a sphere, so an eye within sees the inside
-     * either way: the radius is |r|. */
-    if (!(x[3] != 0)) return fail(lx->w, "sphere radius must not be 0", lx->tok);
-    add_sphere(s, v3(x[0], x[1], x[2]), fabs(x[3]), mat);
-    return 1;
-}
-
-/* c: base centre and radius, apex centre and radius. */
-static int nff_cone(Scene *s, Lexer *lx, int mat)
-{
-    real x[8];
-    if (!nff_numbers(lx, "c", 8, x)) return 0;
-    if (x[3] < 0 && x[7] < 0) {   /* seen only from inside, as a sphere's negative radius */
-        x[3] = -x[3];
-        x[7] = -x[7];
-    }
-    return check_cone(s, lx->w, x, mat);
-}
-
-/* The rest of a byte order mark, whose first byte is lx->c. */
-static int skip_bom(Lexer *lx)
-{
-    int b1 = getc(lx->f), b2 = getc(lx->f);
-    if (b1 != (unsigned char)BOM[1] || b2 != (unsigned char)BOM[2])
-        return fail(lx->w, "not an NFF file: it starts with byte 0xEF, yet no UTF-8 byte order mark",
-                    NULL);
-    lx->c = getc(lx->f);
-    return 1;
-}
-
-static int load_nff(Scene *s, FILE *f, Where w)
-{
-    Lexer lx;
-    int mat = -1, k, ok = 1, got = 1;
-    double intensity;
-    lx.f = f; lx.w = w; lx.w.line = 1; lx.c = getc(f); lx.prev = 0; lx.again = 0;
-    if (lx.c == (unsigned char)BOM[0] && !skip_bom(&lx)) return 0;
-    s->tir_reflect = 1;                          /* the SPD's rule */
-    while (ok && (got = next_token(&lx)) > 0) {
-        const char *t = lx.tok;
-        if (mat < 0 && strchr("spc", t[0])) {    /* objects before any f: plain white */
-            Material m;
-            m.color = v3(1, 1, 1); m.kd = 1; m.ks = m.kt = m.kl = m.shine = 0; m.ir = 1;
-            mat = add_material(s, m);
-        }
-        if (!strcmp(t, "v")) ok = nff_view(s, &lx);
-        else if (!strcmp(t, "b")) ok = nff_background(s, &lx);
-        else if (!strcmp(t, "l")) ok = nff_light(s, &lx);
-        else if (!strcmp(t, "f")) ok = nff_material(s, &lx, &mat);
-        else if (!strcmp(t, "s")) ok = nff_sphere(s, &lx, mat);
-        else if (!strcmp(t, "c")) ok = nff_cone(s, &lx, mat);
-        else if (!strcmp(t, "p")) ok = nff_polygon(s, &lx, 0, mat);
-        else if (!strcmp(t, "pp")) ok = nff_polygon(s, &lx, 1, mat);
-        else ok = fail(lx.w, "unknown NFF entity", t);
-    }
-    ok = ok && got == 0;                         /* the end, not a bad token */
-    /* The SPD's suggested strength: sqrt(L) / (2 L) for each of L lights and
-     * for the ambient, so that the total stays about the same for any L. */
-    intensity = s->nlight ? sqrt((double)s->nlight) / (2.0 * s->nlight) : 0;
-    for (k = 0; k < s->nlight; k++) s->light[k].color = scale((real)intensity, s->light[k].color);
-    s->ambient = v3((real)intensity, (real)intensity, (real)intensity);
-    return ok;
-}
-
-/* Does name end with ext (given in lower case), in any case? */
-static int has_extension(const char *name, const char *ext)
-{
-    size_t n = strlen(name), k = strlen(ext), i;
-    if (n < k) return 0;
-    for (i = 0; i < k; i++)
-        if (tolower((unsigned char)name[n - k + i]) != ext[i]) return 0;
-    return 1;
-}
-
-/* The scene by its name: NFF when it ends .nff (or .NFF), else the sphere
- * format. */
+/* The scene in file, read by scene.c; 0 after a message. */
 static int load_scene(Scene *s, const char *file)
 {
-    Where w = { file, 0 };
-    FILE *f = fopen(file, "r");
-    int ok;
+    scene_builder b = builder(s);
     default_scene(s);
-    if (!f) return fail(w, "cannot open scene", strerror(errno));
-    ok = has_extension(file, ".nff") ? load_nff(s, f, w) : load_sph(s, f, w);
-    if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
-    fclose(f);
-    return ok;
+    return read_scene(&b, file);
 }
 
-/* ------------------------------------------------------------------ output */
-
-enum { FORMAT_PPM, FORMAT_PNG, FORMAT_PFM, FORMAT_OTHER };
-
-/* The format -o asks for, by its extension: .png is PNG, .pfm PFM (floats,
- * the radiance itself); anything else is
- * PPM (.ppm, stdout, a device, a name without an extension), except the
- * image formats this program cannot write, which are refused rather than
- * given a PPM under their name. */
-static int output_format(const char *name)
-{
-    static const char *const other[] = { ".jpg", ".jpeg", ".gif", ".bmp", ".tif", ".tiff",
-                                         ".webp", ".tga", ".exr", ".hdr" };
-    size_t i;
-    if (has_extension(name, ".png")) return FORMAT_PNG;
-    if (has_extension(name, ".pfm")) return FORMAT_PFM;
-    for (i = 0; i < sizeof other / sizeof *other; i++)
-        if (has_extension(name, other[i])) return FORMAT_OTHER;
-    return FORMAT_PPM;
-}
-
-/* PNG (ISO/IEC 15948) without a compressor: the rows, each after filter
- * byte 0 ("none"), make a zlib stream (RFC 1950) of stored deflate blocks
- * (RFC 1951: a block's bytes as they are, after their count and its
- * complement), one IDAT chunk per block.  Each chunk ends with the CRC-32
- * of its type and data; the zlib stream ends with the Adler-32 of the rows. */
-#define STORED_MAX 65535                  /* the most bytes a stored block holds */
-
-typedef struct {
-    FILE *f;
-    unsigned long crc[256];               /* CRC-32 of each byte value */
-    unsigned long a, b;                   /* Adler-32's two sums */
-    unsigned char buf[2 + 5 + STORED_MAX + 4]; /* one IDAT chunk's data */
-    size_t n, start;                      /* bytes in buf; where the block's bytes start */
-} Png;
-
-/* The table of CRC-32 (the polynomial of ISO 3309, bits reversed). */
-static void crc_table(unsigned long t[256])
-{
-    unsigned long c;
-    int n, k;
-    for (n = 0; n < 256; n++) {
-        for (c = (unsigned long)n, k = 0; k < 8; k++) c = c & 1 ? 0xEDB88320UL ^ c >> 1 : c >> 1;
-        t[n] = c;
-    }
-}
-
-static unsigned long crc_update(const unsigned long t[256], unsigned long crc,
-                                const unsigned char *p, size_t n)
-{
-    while (n--) crc = t[(crc ^ *p++) & 0xFF] ^ crc >> 8;
-    return crc;
-}
-
-/* Four bytes, most significant first, as PNG and zlib store numbers. */
-static void put32(unsigned char *p, unsigned long v)
-{
-    p[0] = (unsigned char)(v >> 24 & 0xFF);
-    p[1] = (unsigned char)(v >> 16 & 0xFF);
-    p[2] = (unsigned char)(v >> 8 & 0xFF);
-    p[3] = (unsigned char)(v & 0xFF);
-}
-
-/* One chunk: its length, type, data and CRC. */
-static void png_chunk(Png *png, const char *type, const unsigned char *data, size_t n)
-{
-    unsigned char head[8], tail[4];
-    put32(head, (unsigned long)n);
-    memcpy(head + 4, type, 4);
-    put32(tail, crc_update(png->crc, crc_update(png->crc, 0xFFFFFFFFUL, head + 4, 4), data, n)
-                    ^ 0xFFFFFFFFUL);
-    fwrite(head, 1, 8, png->f);
-    fwrite(data, 1, n, png->f);
-    fwrite(tail, 1, 4, png->f);
-}
-
-/* The block in buf as an IDAT chunk; the last one also closes the zlib
- * stream with its Adler-32.  The next block's header goes at buf[0]. */
-static void png_block(Png *png, int last)
-{
-    size_t len = png->n - png->start;
-    unsigned char *head = png->buf + png->start - 5;
-    head[0] = (unsigned char)last;        /* BFINAL, and BTYPE 00: stored */
-    head[1] = (unsigned char)(len & 0xFF);
-    head[2] = (unsigned char)(len >> 8);
-    head[3] = (unsigned char)(~len & 0xFF);
-    head[4] = (unsigned char)(~len >> 8 & 0xFF);
-    if (last) {
-        put32(png->buf + png->n, png->b << 16 | png->a);
-        png->n += 4;
-    }
-    png_chunk(png, "IDAT", png->buf, png->n);
-    png->n = png->start = 5;
-}
-
-/* Bytes of the rows into the zlib stream, a stored block at a time. */
-static void png_put(Png *png, const unsigned char *p, size_t n)
-{
-    while (n > 0) {
-        size_t room = STORED_MAX - (png->n - png->start), k = n < room ? n : room, i;
-        if (room == 0) { png_block(png, 0); continue; }
-        for (i = 0; i < k; i++) {
-            png->a = (png->a + p[i]) % 65521;
-            png->b = (png->b + png->a) % 65521;
-        }
-        memcpy(png->buf + png->n, p, k);
-        png->n += k;
-        p += k;
-        n -= k;
-    }
-}
-
-/* An 8-bit RGB PNG; with srgb, it says its bytes are sRGB (the sRGB chunk,
- * and gAMA 1/2.2 for readers that know only that). 0: out of memory. */
-static int write_png(FILE *f, const unsigned char *img, int w, int h, int srgb)
-{
-    static const unsigned char signature[8] = { 137, 'P', 'N', 'G', 13, 10, 26, 10 };
-    unsigned char ihdr[13] = { 0 }, zero = 0, gamma[4];
-    Png *png = malloc(sizeof *png);
-    int j;
-    if (!png) return 0;
-    png->f = f;
-    crc_table(png->crc);
-    png->a = 1;
-    png->b = 0;
-    png->buf[0] = 0x78;                   /* zlib: deflate, 32K window; */
-    png->buf[1] = 0x01;                   /* 0x7801 is a multiple of 31 */
-    png->n = png->start = 2 + 5;
-    fwrite(signature, 1, 8, f);
-    put32(ihdr, (unsigned long)w);
-    put32(ihdr + 4, (unsigned long)h);
-    ihdr[8] = 8;                          /* bits per channel */
-    ihdr[9] = 2;                          /* RGB; compression, filter, interlace 0 */
-    png_chunk(png, "IHDR", ihdr, 13);
-    if (srgb) {
-        put32(gamma, 45455);
-        png_chunk(png, "sRGB", &zero, 1); /* rendering intent 0, perceptual */
-        png_chunk(png, "gAMA", gamma, 4);
-    }
-    for (j = 0; j < h; j++) {
-        png_put(png, &zero, 1);           /* filter type 0, none */
-        png_put(png, img + (size_t)3 * w * j, (size_t)3 * w);
-    }
-    png_block(png, 1);
-    png_chunk(png, "IEND", png->buf, 0);
-    free(png);
-    return 1;
-}
-
-static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain)
-{
-    size_t i, n = (size_t)w * h * 3;
-    fprintf(f, "%s\n%d %d\n255\n", plain ? "P3" : "P6", w, h);
-    if (plain)
-        for (i = 0; i < n; i += 3) fprintf(f, "%d %d %d\n", img[i], img[i + 1], img[i + 2]);
-    else
-        fwrite(img, 1, n, f);
-}
-
-/* Where the image goes.  It is opened before the render, so that a bad -o
- * fails at once rather than after a long render.  A new or plain file is
- * written to a temporary file of this run's own beside it (FILE.tmp.PID),
- * which is renamed over FILE at the end: a failure or an interrupt never
- * leaves a half-written image, and keeps the old one.  Anything else
- * (stdout, a device such as /dev/null, a pipe, a symbolic link) is written
- * in place and never renamed over or removed. */
-typedef struct { FILE *f; const char *name; char *tmp; int format; } Output;
-
-/* The temporary file's name, for on_signal, which can be handed nothing:
- * the one global of ray.c (the card has its own).  It is written before the
- * handler is installed, and the handler only reads it. */
-static char signal_tmp[4096];
-
-/* Ctrl-C (SIGINT), SIGTERM, or a closed terminal (SIGHUP) during a render:
- * the temporary file is removed, then the signal raised again with its
- * default action, so that the program ends as that signal ends it (a shell
- * shows 128 + its number) and the old output stays.  Only calls that are
- * safe in a signal handler: unlink (remove, where there is no unlink),
- * signal and raise. */
-static void on_signal(int sig)
-{
-#ifdef RAY_POSIX
-    unlink(signal_tmp);
-#else
-    remove(signal_tmp);
-#endif
-    signal(sig, SIG_DFL);
-    raise(sig);
-}
-
-/* Is sig ignored (as nohup, or a shell for a background job, leaves it)?
- * Then it stays ignored. */
-static int ignored(int sig)
-{
-#ifdef RAY_POSIX
-    struct sigaction sa;
-    return sigaction(sig, NULL, &sa) == 0 && sa.sa_handler == SIG_IGN;
-#else
-    (void)sig;
-    return 0;
-#endif
-}
-
-/* on_signal for the temporary file tmp, or with tmp NULL the default
- * action again (the file is renamed into place, or gone).  A name too long
- * for signal_tmp, which no system takes, is left to the default action. */
-static void catch_signals(const char *tmp)
-{
-#ifdef RAY_POSIX
-    static const int sigs[] = { SIGINT, SIGTERM, SIGHUP };
-#else
-    static const int sigs[] = { SIGINT, SIGTERM };
-#endif
-    size_t i;
-    if (tmp && strlen(tmp) >= sizeof signal_tmp) return;
-    if (tmp) strcpy(signal_tmp, tmp);
-    for (i = 0; i < sizeof sigs / sizeof *sigs; i++)
-        if (!ignored(sigs[i])) signal(sigs[i], tmp ? on_signal : SIG_DFL);
-}
-
-/* Nothing but this run may have opened the file: created here (O_EXCL: not
- * if it exists, and never through a symbolic link), or NULL with errno
- * EEXIST.  Without POSIX, the best plain C can do: fail if it can be read. */
-static FILE *create_new(const char *name)
-{
-#ifdef RAY_POSIX
-    int fd = open(name, O_WRONLY | O_CREAT | O_EXCL, 0666);
-    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb");
-    if (fd >= 0 && !f) { close(fd); unlink(name); }
-    return f;
-#else
-    FILE *f = fopen(name, "rb");
-    if (f) { fclose(f); errno = EEXIST; return NULL; }
-    return fopen(name, "wb");
-#endif
-}
-
-/* This process's number, to tell its temporary files from another run's. */
-static long process_id(void)
-{
-#if defined(RAY_POSIX)
-    return (long)getpid();
-#elif defined(_WIN32)
-    return (long)_getpid();
-#else
-    return (long)time(NULL);
-#endif
-}
-
-/* A temporary file beside name that no other run shares: name.tmp.PID, or
- * name.tmp.PID.K when that exists (left by a run that was killed). */
-static FILE *create_temp(const char *name, char **tmp)
-{
-    int k;
-    FILE *f = NULL;
-    *tmp = malloc(strlen(name) + 48);
-    if (!*tmp) return NULL;
-    for (k = 0; k < 100 && !f; k++) {
-        if (k) sprintf(*tmp, "%s.tmp.%ld.%d", name, process_id(), k);
-        else sprintf(*tmp, "%s.tmp.%ld", name, process_id());
-        f = create_new(*tmp);
-        if (!f && errno != EEXIST) break;
-    }
-    return f;
-}
-
-enum { IN_PLACE, VIA_TEMP, REFUSED };
-
-#ifdef RAY_POSIX
-/* How -o FILE is written: a plain file or a new one through a temporary
- * (*mode: the old file's permissions, which the new one keeps; -1 for a new
- * file), anything else in place.  A read-only file is refused, with a
- * message: replacing it would defeat its protection (root may write any
- * file, so its mode bits are asked too). */
-static int output_kind(const char *name, int *mode)
-{
-    struct stat st;
-    *mode = -1;
-    if (lstat(name, &st) != 0) return errno == ENOENT ? VIA_TEMP : IN_PLACE;
-    if (!S_ISREG(st.st_mode)) return IN_PLACE;
-    if (access(name, W_OK) != 0 || !(st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH))) {
-        fprintf(stderr, "%s: is read-only; not replaced (make it writable, or write elsewhere)\n",
-                name);
-        return REFUSED;
-    }
-    *mode = (int)(st.st_mode & 07777);
-    return VIA_TEMP;
-}
-#else
-static int output_kind(const char *name, int *mode)
-{
-    FILE *f = fopen(name, "rb");
-    *mode = -1;
-    if (f) {
-        fclose(f);
-        f = fopen(name, "r+b");     /* opens for writing without changing it */
-        if (!f) {
-            fprintf(stderr, "%s: is read-only; not replaced (make it writable, or write elsewhere)\n",
-                    name);
-            return REFUSED;
-        }
-        fclose(f);
-    }
-    return VIA_TEMP;
-}
-#endif
-
-/* Opens -o name for writing (see Output).  0 after a message. */
-static int open_output(Output *o, const char *name)
-{
-    int mode, kind;
-    o->name = name;
-    o->tmp = NULL;
-    o->f = stdout;
-    o->format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
-    if (!strcmp(name, "-")) {
-#ifdef _WIN32
-        _setmode(_fileno(stdout), _O_BINARY);    /* P6 and PNG bytes as they are: no \r added */
-#endif
-        return 1;
-    }
-    kind = output_kind(name, &mode);
-    if (kind == REFUSED) return 0;
-    o->f = kind == VIA_TEMP ? create_temp(name, &o->tmp) : fopen(name, "wb");
-#ifdef RAY_POSIX
-    if (o->f && mode >= 0) fchmod(fileno(o->f), (mode_t)mode);
-#endif
-    if (o->f) {
-        if (o->tmp) catch_signals(o->tmp);
-        return 1;
-    }
-    fprintf(stderr, "%s: cannot write: %s\n", o->tmp ? o->tmp : name, strerror(errno));
-    free(o->tmp);
-    return 0;
-}
-
-/* Gives up an output: nothing is left of it. */
-static void discard_output(Output *o)
-{
-    if (o->f != stdout) fclose(o->f);
-    if (o->tmp) remove(o->tmp);
-    if (o->tmp) catch_signals(NULL);
-    free(o->tmp);
-}
-
-/* PFM, netpbm's floating-point format: "PF" (colour), the size, and -1 for
- * little-endian floats; then the rows from the bottom up. */
-static void write_pfm(FILE *f, const Image *img)
-{
-    int i, j, c;
-    fprintf(f, "PF\n%d %d\n-1.0\n", img->w, img->h);
-    for (j = img->h - 1; j >= 0; j--)
-        for (i = 0; i < 3 * img->w; i++) {
-            float x = img->floats[(size_t)j * 3 * img->w + i];
-            uint32_t u;
-            unsigned char b[4];
-            memcpy(&u, &x, 4);
-            for (c = 0; c < 4; c++) b[c] = (unsigned char)(u >> 8 * c);
-            fwrite(b, 1, 4, f);
-        }
-}
-
-/* rename() over an existing file: POSIX replaces it in one step; Windows
- * refuses, so there the old file is removed first (for a moment there is
- * neither: the best plain C can do). */
-static int replace_file(const char *from, const char *to)
-{
-#ifdef _WIN32
-    remove(to);
-#endif
-    return rename(from, to);
-}
-
-/* The image in the output's format, then the file closed and, if it was
- * written as a temporary, renamed into place; on failure a message and no
- * file.  A PNG of sRGB bytes says so. */
-static int write_image(Output *o, const Image *img, int plain)
-{
-    int ok = 1;
-    errno = 0;
-    if (o->format == FORMAT_PFM) write_pfm(o->f, img);
-    else if (o->format == FORMAT_PNG) {
-        ok = write_png(o->f, img->bytes, img->w, img->h, img->srgb);
-        if (!ok) errno = ENOMEM;
-    } else
-        write_ppm(o->f, img->bytes, img->w, img->h, plain);
-    ok = ok && fflush(o->f) == 0 && !ferror(o->f);
-    if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
-    if (ok && o->tmp) ok = replace_file(o->tmp, o->name) == 0;
-    if (!ok) {
-        fprintf(stderr, "%s: cannot write: %s\n", o->name, strerror(errno));
-        if (o->tmp) remove(o->tmp);
-    }
-    if (o->tmp) catch_signals(NULL);
-    free(o->tmp);
-    return ok;
-}
-
-/* ------------------------------------------------------------ command line */
-
-static void usage(FILE *to)
-{
-    fputs("usage: ray [options] SCENE\n"
-          "Renders SCENE with Whitted ray tracing, or path tracing (--pt): the sphere\n"
-          "format (README.md), or NFF (Eric Haines' Neutral File Format, the SPD\n"
-          "scenes') when it ends .nff.\n"
-          "  -o FILE    output image: PNG if FILE ends .png, PFM (floats) if .pfm, else\n"
-          "             PPM (default: SCENE's base name + .ppm; - for stdout)\n"
-          "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
-          "  -n N       samples per pixel (default: the scene's `samples`, else 1)\n"
-          "  -d N       Whitted: recursion depth, 1 = primary rays only (default: the\n"
-          "             scene's, else 5); path tracing: rays a path may have (default:\n"
-          "             the scene's `depth`, else no bound but Russian roulette)\n"
-          "  -t N       threads (default: all cores, when built with OpenMP)\n"
-          "  --pt       path tracing (Kajiya's rendering equation); --whitted: Whitted's\n"
-          "             (default: the scene's `integrator`, else Whitted)\n"
-          "  --estimator E  the path tracer's: bsdf (BSDF sampling only), nee (next-event\n"
-          "             estimation) or mis (both, by multiple importance sampling; default)\n"
-          "  --no-roulette  no Russian roulette: paths end at -d only\n"
-          "  --seed N   the path tracer's noise (default 0): another N, other noise\n"
-          "  --p3       write plain-text P3 instead of binary P6\n"
-          "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
-          "             card's; a path-traced image always has it, but for PFM)\n"
-          "  --accel A  kd (the kd-tree), bvh (bounding volume hierarchy), grid\n"
-          "             (uniform grid), none (test every object) or auto (default:\n"
-          "             the scene's `accel` line, else from 8 objects up the one that\n"
-          "             renders a 32x32 probe of the image fastest, its build included)\n"
-          "  --view V   instead of the picture, what a ray through each pixel's centre\n"
-          "             meets: steps (the structure's work: nodes or cells plus tests,\n"
-          "             black 0, blue 25, red 50, yellow 100, white 200), normal, depth\n"
-          "  --stats    print rays by kind, hits, the tree and time on stderr\n"
-          "  --help     this text\n", to);
-}
-
-#define RAY_VERSION "1.0"
-
-static void version(void)
-{
-#ifdef _OPENMP
-    const char *threads = "OpenMP threads";
-#else
-    const char *threads = "one thread, no OpenMP";
-#endif
-    printf("ray " RAY_VERSION ", Whitted ray tracer in C99 (%s, %s)\n",
-           sizeof(real) == sizeof(float) ? "float" : "double", threads);
-}
-
-/* The value of option opt ("-n", "--accel") if argv[*i] is that option:
- * attached ("-n4", "--accel=kd") or the next argument ("-n 4"), which is
- * then used up.  NULL if argv[*i] is another option; a usage error (exit 2)
- * if the value is missing. */
-static const char *option_value(int argc, char **argv, int *i, const char *opt)
-{
-    const char *a = argv[*i];
-    size_t n = strlen(opt);
-    if (strncmp(a, opt, n)) return NULL;
-    if (a[n] && opt[1] != '-') return a + n;
-    if (a[n]) return a[n] == '=' ? a + n + 1 : NULL;
-    if (*i + 1 >= argc) {
-        fprintf(stderr, "ray: %s needs a value (see ray --help)\n", opt);
-        exit(2);
-    }
-    return argv[++*i];
-}
-
-/* --accel's value, or a usage error (exit 2) that lists the choices. */
-static const char *accel_arg(const char *v)
-{
-    if (!accel_name(v)) {
-        fprintf(stderr, "ray: --accel takes kd (the kd-tree), bvh (bounding volume hierarchy), grid"
-                " (uniform grid), none (every object) or auto, not %s\n", v);
-        exit(2);
-    }
-    return accel_name(v);
-}
-
-/* --view's picture, or a usage error (exit 2) with the choices. */
-static int view_arg(const char *v)
-{
-    if (!strcmp(v, "steps")) return VIEW_STEPS;
-    if (!strcmp(v, "normal")) return VIEW_NORMAL;
-    if (strcmp(v, "depth")) {
-        fprintf(stderr, "ray: --view takes steps, normal or depth, not %s\n", v);
-        exit(2);
-    }
-    return VIEW_DEPTH;
-}
-
-/* The path tracer's estimator named by --estimator, or exit with the choices. */
-static int estimator_arg(const char *v)
-{
-    if (!strcmp(v, "bsdf")) return BSDF_ONLY;
-    if (!strcmp(v, "nee")) return NEE;
-    if (strcmp(v, "mis")) {
-        fprintf(stderr, "ray: --estimator takes bsdf (BSDF sampling only), nee (next-event"
-                " estimation) or mis, not %s\n", v);
-        exit(2);
-    }
-    return MIS;
-}
-
-/* -t asks for threads that a build without OpenMP does not have: said once. */
-static void warn_threads(int threads)
-{
-#ifndef _OPENMP
-    if (threads) fprintf(stderr, "ray: warning: -t %d is ignored: built without OpenMP, one thread\n", threads);
-#else
-    (void)threads;
-#endif
-}
-
-/* Is -o name another file than the scene?  Else a message: the render
- * would overwrite its own scene.  The same file by device and inode under
- * POSIX (through links, and however the path is spelled), else by name. */
-static int apart(const char *scene, const char *name)
-{
-#ifdef RAY_POSIX
-    struct stat a, b;
-    int same = stat(scene, &a) == 0 && stat(name, &b) == 0 && a.st_dev == b.st_dev
-               && a.st_ino == b.st_ino;
-#else
-    int same = !strcmp(scene, name);
-#endif
-    if (same) fprintf(stderr, "ray: -o %s is the scene file; not overwritten\n", name);
-    return !same;
-}
-
-/* A whole number from 1 to max, or exit with a message naming the option. */
-static int int_arg(const char *opt, const char *arg, int max)
-{
-    char *end;
-    long v = arg ? strtol(arg, &end, 10) : 0;
-    if (!arg || end == arg || *end || v < 1 || v > max) {
-        fprintf(stderr, "ray: %s needs a whole number from 1 to %d%s%s\n", opt, max,
-                arg ? ", not " : "", arg ? arg : "");
-        exit(2);
-    }
-    return (int)v;
-}
-
-/* Can -o FILE be written as asked?  Else a message (a usage error). */
-static int output_usable(const char *name, int plain)
-{
-    int format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
-    if (format == FORMAT_OTHER)
-        fprintf(stderr, "ray: cannot write %s: the formats are PPM, PNG and PFM (-o x.ppm, x.png, x.pfm)\n",
-                name);
-    else if (format != FORMAT_PPM && plain)
-        fprintf(stderr, "ray: --p3 is a PPM form; %s is a %s\n", name,
-                format == FORMAT_PNG ? "PNG" : "PFM");
-    return format == FORMAT_PPM || (format != FORMAT_OTHER && !plain);
-}
-
-static char *default_output(const char *scene)
-{
-    const char *base = file_part(scene), *dot = strrchr(base, '.');
-    char *out;
-    out = malloc(strlen(base) + 5);
-    if (!out) out_of_memory();
-    sprintf(out, "%.*s.ppm", dot ? (int)(dot - base) : (int)strlen(base), base);
-    return out;
-}
 
 /* From this many objects on, the tree pays; below, a loop over them all
  * costs less than walking even a small tree.  Measured on scenes of random
@@ -3716,14 +2430,89 @@ static int build_accel(Scene *s, const char *accel)
     return ok;
 }
 
-static void print_stats(const Scene *s, const Counts *st, int spp, double load, double build,
-                        double seconds, double cpu)
+/* Objects that glow (kl > 0): the path tracer's area lights, and for
+ * Whitted's the spheres that are lights. */
+static int glowing(const Scene *s)
+{
+    int i, k, n = 0;
+    for (i = 0; i < nobj(s); i++) {
+        int what = kind(s, i, &k);
+        n += s->mat[what == SPHERE ? s->sph[k].mat : what == CONE ? s->cone[k].mat : s->tri[k].mat].kl > 0;
+    }
+    return n;
+}
+
+static int point_lights(const Scene *s)
+{
+    int i, n = 0;
+    for (i = 0; i < s->nlight; i++) n += s->light[i].sphere < 0;
+    return n;
+}
+
+static unsigned long long all_rays(const Counts *st)
+{
+    return st->primary + st->shadow + st->reflected + st->refracted + st->bounced;
+}
+
+/* --stats=kv: the figures of --stats as `key value` lines, one a line, for
+ * programs to read (bench/run.sh does); the README lists the keys. */
+static void print_stats_kv(const Scene *s, const Counts *st, int spp, double load, double build,
+                           double seconds, double cpu)
+{
+    static const char *const accels[] = { "none", "kd", "bvh", "grid" };
+    static const char *const estimators[] = { "bsdf", "nee", "mis" };
+    FILE *f = stderr;
+    fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
+            s->nsph, s->ncone, s->ntri, point_lights(s), glowing(s));
+    fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", s->w, s->h, spp,
+            st->threads, s->integrator == PATH ? "path" : "whitted");
+    if (s->integrator == PATH)
+        fprintf(f, "estimator %s\nroulette %d\nmax_rays %d\nseed %u\nlights %d\n",
+                estimators[s->estimator], s->roulette, s->max_rays, s->seed, s->nemit);
+    else
+        fprintf(f, "depth %d\n", s->depth);
+    fprintf(f, "accel %s\n", accels[s->accel]);
+    if (s->accel == ACCEL_KD) {
+        kd_info k;
+        kd_describe(s->kd, &k);
+        fprintf(f, "accel_nodes %ld\naccel_leaves %ld\naccel_empty_leaves %ld\naccel_depth %ld\n"
+                "accel_prims_per_leaf %.4f\naccel_bytes %.0f\naccel_sah_cost %.4f\n", k.nodes,
+                k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf, (double)k.bytes, k.sah_cost);
+    } else if (s->accel == ACCEL_BVH) {
+        bvh_info b;
+        bvh_describe(s->bvh, &b);
+        fprintf(f, "accel_nodes %ld\naccel_leaves %ld\naccel_depth %ld\naccel_prims_per_leaf %.4f\n"
+                "accel_bytes %lu\naccel_sah_cost %.4f\n", b.nodes, b.leaves, b.max_depth,
+                b.prims_per_leaf, (unsigned long)b.bytes, b.sah_cost);
+    } else if (s->accel == ACCEL_GRID) {
+        grid_info g;
+        grid_describe(s->grid, &g);
+        fprintf(f, "grid_cells %dx%dx%d\naccel_empty_cells %ld\naccel_refs %ld\naccel_bytes %lu\n",
+                g.res[0], g.res[1], g.res[2], g.empty_cells, (long)g.prim_refs, (unsigned long)g.bytes);
+    }
+    fprintf(f, "rays %llu\nrays_primary %llu\nrays_shadow %llu\nrays_reflected %llu\n"
+            "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
+            all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced, st->cut,
+            st->discarded);
+    fprintf(f, "queries %llu\nnearest_queries %llu\nhits %llu\ntests %llu\nsteps %llu\n",
+            st->queries, st->nearest, st->hits, st->tests, st->steps);
+    fprintf(f, "load_s %.6f\nbuild_s %.6f\nrender_s %.6f\ncpu_s %.6f\n", load, build, seconds, cpu);
+}
+
+/* --stats: rays by kind, hits, the structure and the time, in words; with
+ * kv, as print_stats_kv. */
+static void print_stats(const Scene *s, const Counts *st, int spp, int kv, double load,
+                        double build, double seconds, double cpu)
 {
     static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
                                               "MIS (BSDF sampling and next-event estimation)" };
-    unsigned long long rays = st->primary + st->shadow + st->reflected + st->refracted + st->bounced;
-    fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d lights; read in %.3f s\n",
-            s->nsph, s->ncone, s->ntri, s->nlight, load);
+    unsigned long long rays = all_rays(st);
+    if (kv) {
+        print_stats_kv(s, st, spp, load, build, seconds, cpu);
+        return;
+    }
+    fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d point lights, %d glowing;"
+            " read in %.3f s\n", s->nsph, s->ncone, s->ntri, point_lights(s), glowing(s), load);
     if (s->integrator == PATH)
         fprintf(stderr, "image      %dx%d, %d spp, path traced, %d thread%s\n", s->w, s->h, spp,
                 st->threads, st->threads == 1 ? "" : "s");
@@ -3797,113 +2586,55 @@ static int settle_path_options(Scene *s, int integrator, int estimator, int roul
     s->roulette = roulette;
     if (s->integrator != PATH) return 1;
     if (!roulette && !s->max_rays) {
-        fprintf(stderr, "ray: --no-roulette needs -d N: without either, paths would not end\n");
+        fprintf(stderr, "ray: --no-roulette needs -d N (or the scene's `depth`): without either,"
+                " paths would not end\n");
         return 0;
     }
     prepare_lights(s);
     return 1;
 }
 
-/* An image of w x h pixels, floats or bytes (through the sRGB curve for a
- * path-traced one, and with --gamma). */
-static int new_image(Image *img, int w, int h, int floats, int srgb)
-{
-    img->w = w;
-    img->h = h;
-    img->srgb = srgb;
-    img->bytes = floats ? NULL : malloc((size_t)w * h * 3);
-    img->floats = floats ? malloc((size_t)w * h * 3 * sizeof *img->floats) : NULL;
-    return img->bytes || img->floats;
-}
-
-/* -s WxH into *w, *h; 0 with a message when it is not such a size. */
-static int parse_size(const char *size, int *w, int *h)
-{
-    char *x, *end = NULL;
-    long fw = strtol(size, &x, 10), fh = *x == 'x' ? strtol(x + 1, &end, 10) : 0;
-    if (x == size || *x != 'x' || end == x + 1 || *end) {
-        fprintf(stderr, "ray: -s needs WxH, like 640x480, not %s\n", size);
-        return 0;
-    }
-    if (!check_size((double)fw, (double)fh, w, h)) {
-        fprintf(stderr, "ray: -s %s: " SIZE_RULE "\n", size);
-        return 0;
-    }
-    return 1;
-}
-
+/* The program: the command line (cli.c), the scene (scene.c), the
+ * structure, the output opened, render(), the image written (image.c). */
 int main(int argc, char **argv)
 {
+    Args a;
     Scene s;
-    Options o = { 0, 0, 0, 0 };
+    Options o;
     Counts st;
     Output out;
     Image img;
-    const char *scene = NULL, *size = NULL, *accel = NULL, *name = NULL;
-    char *auto_name = NULL;
-    int i, depth = 0, plain = 0, stats = 0, gamma = 0, ok, w = 0, h = 0, integrator = -1;
-    int estimator = -1, roulette = 1, view = 0;
-    long seed = -1;
+    const char *accel;
+    int ok, done = parse_args(argc, argv, &a);
     double t0, load, build;
     clock_t c0;
 
-    for (i = 1; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) { usage(stdout); return 0; }
-        else if (!strcmp(a, "--version")) { version(); return 0; }
-        else if ((v = option_value(argc, argv, &i, "-o"))) name = v;
-        else if ((v = option_value(argc, argv, &i, "-s"))) size = v;
-        else if ((v = option_value(argc, argv, &i, "-n"))) o.spp = int_arg("-n", v, 1 << 20);
-        else if ((v = option_value(argc, argv, &i, "-d"))) depth = int_arg("-d", v, 64);
-        else if ((v = option_value(argc, argv, &i, "-t"))) o.threads = int_arg("-t", v, 4096);
-        else if ((v = option_value(argc, argv, &i, "--accel"))) accel = accel_arg(v);
-        else if (!strcmp(a, "--p3")) plain = 1;
-        else if (!strcmp(a, "--gamma")) gamma = 1;
-        else if (!strcmp(a, "--stats")) stats = 1;
-        else if ((v = option_value(argc, argv, &i, "--view"))) view = view_arg(v);
-        else if (!strcmp(a, "--pt")) integrator = PATH;
-        else if (!strcmp(a, "--whitted")) integrator = WHITTED;
-        else if (!strcmp(a, "--no-roulette")) roulette = 0;
-        else if ((v = option_value(argc, argv, &i, "--seed"))) seed = int_arg("--seed", v, 2147483647) - 1;
-        else if ((v = option_value(argc, argv, &i, "--estimator"))) estimator = estimator_arg(v);
-        else if (a[0] == '-' && a[1]) {
-            fprintf(stderr, "ray: unknown option: %s\n", a);
-            usage(stderr);
-            return 2;
-        } else if (scene) {
-            fprintf(stderr, "ray: one scene only (%s and %s)\n", scene, a);
-            return 2;
-        }
-        else scene = a;
-    }
-    if (!scene) { usage(stderr); return 2; }
-    if (!name) name = auto_name = default_output(scene);
-    if ((size && !parse_size(size, &w, &h)) || !output_usable(name, plain)
-        || !apart(scene, name)) {
-        free(auto_name);
-        return 2;
-    }
-    warn_threads(o.threads);
+    if (done >= 0) return done;
     load = now();
-    ok = load_scene(&s, scene);
-    if (ok && size) { s.w = w; s.h = h; }
+    ok = load_scene(&s, a.scene);
+    if (ok && a.w) { s.w = a.w; s.h = a.h; }
     load = now() - load;
-    if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", scene);
-    if (depth) s.depth = s.max_rays = depth;
-    if (!accel) accel = s.accel_line ? s.accel_line : "auto";
-    if (ok && !settle_path_options(&s, integrator, estimator, roulette, seed)) ok = 0;
-    if (!o.spp) o.spp = s.spp ? s.spp : 1;
+    if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", a.scene);
+    if (a.depth) s.depth = s.max_rays = a.depth;
+    accel = a.accel ? a.accel : s.accel_line ? s.accel_line : "auto";
+    if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {
+        free_scene(&s); free(a.made);
+        return 2;                   /* --no-roulette without -d: a usage error */
+    }
+    memset(&o, 0, sizeof o);
+    o.spp = a.spp ? a.spp : s.spp ? s.spp : 1;
+    o.threads = a.threads;
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
-    if (!ok || !open_output(&out, name)) { free_scene(&s); free(auto_name); return 1; }
+    if (!ok || !open_output(&out, a.output)) { free_scene(&s); free(a.made); return 1; }
 
-    s.view = view;
-    if (view == VIEW_DEPTH) s.far = farthest(&s);
-    if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, !view && (s.integrator == PATH || gamma))) {
+    s.view = a.view;
+    if (a.view == VIEW_DEPTH) s.far = farthest(&s);
+    if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, !a.view && (s.integrator == PATH || a.gamma))) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h);
         discard_output(&out);
-        free_scene(&s); free(auto_name);
+        free_scene(&s); free(a.made);
         return 1;
     }
     o.progress = stderr_is_terminal();
@@ -3914,11 +2645,12 @@ int main(int argc, char **argv)
     c0 = clock();
     render(&s, &o, &img, &st);
     t0 = now() - t0;
-    ok = write_image(&out, &img, plain);
-    if (stats) print_stats(&s, &st, o.spp, load, build, t0, (double)(clock() - c0) / CLOCKS_PER_SEC);
-    free(img.bytes);
-    free(img.floats);
-    free(auto_name);
+    ok = write_image(&out, &img, a.plain);
+    if (a.stats)
+        print_stats(&s, &st, o.spp, a.stats == 2, load, build, t0,
+                    (double)(clock() - c0) / CLOCKS_PER_SEC);
+    free_image(&img);
+    free(a.made);
     free_scene(&s);
     return ok ? 0 : 1;
 }

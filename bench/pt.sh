@@ -48,7 +48,7 @@ say() { echo "bench: $*" >&2; }
 
 OMP=$(echo 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
 # shellcheck disable=SC2086
-$CC $CFLAGS $OMP -o "$OUT/ray_pt" ray.c kdtree.c bvh.c grid.c -lm || die "cannot build ray"
+$CC $CFLAGS $OMP -o "$OUT/ray_pt" ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || die "cannot build ray"
 # shellcheck disable=SC2086
 $CC $CFLAGS -o "$OUT/pfmerr" bench/pfmerr.c -lm || die "cannot build pfmerr"
 # shellcheck disable=SC2086

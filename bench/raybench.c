@@ -333,11 +333,9 @@ static void rb_free_scene(Scene *s)
 
 static void rb_load_mesh(Scene *s, const char *path)
 {
-    Where w;
-    w.file = path;
-    w.line = 0;
+    scene_builder b = builder(s);
     default_scene(s);
-    if (!load_obj(s, path, rb_white(s), w)) exit(1);
+    if (!read_obj(&b, path, rb_white(s), path, 0)) exit(1);
     if (s->ntri == 0) rb_die("no triangles in", path);
 }
 

@@ -213,7 +213,7 @@ RAYSRC=(ray.c)
 # Each acceleration module is linked once ray.c uses it, not merely because
 # it exists: a half-written one must not break the bench of a renderer that
 # ignores it.
-for m in kdtree bvh grid; do
+for m in scene image cli kdtree bvh grid; do
   if grep -q "^#include \"$m.h\"" ray.c && [ -f $m.c ]; then RAYSRC+=($m.c); fi
 done
 

@@ -145,7 +145,7 @@ static int frame_mesh(Scene *s)
     v[0] = c[0] + 0.6 * size, v[1] = c[1] - 2 * size, v[2] = c[2] + 0.9 * size;
     v[3] = c[0], v[4] = c[1], v[5] = c[2];
     v[6] = 0, v[7] = 0, v[8] = 1, v[9] = 50;
-    if (!set_camera(s, (Where){ "fuzz", 0 }, v)) return 0;
+    if (!set_camera(s, v, (char[SCENE_WHY]){ 0 })) return 0;
     add_light(s, v3(v[0] - 0.5 * size, v[1], v[2] + size), v3(1, 1, 1), -1);
     return 1;
 }

@@ -47,7 +47,8 @@ cmp -s "$TMP/got" "$TMP/want" && ok "--gamma gives the sRGB curve's bytes, linea
 # points, CRC-32 and Adler-32 check values, extensions, and paths split as
 # POSIX and (-DRAY_DOS_PATHS) as Windows splits them.
 for paths in "" -DRAY_DOS_PATHS; do
-  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c kdtree.c bvh.c grid.c -lm 2> "$TMP/err"; then
+  # shellcheck disable=SC2046 # the parts but image.c, which test_io.c includes
+  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c $(echo " $RAY_PARTS " | sed "s/ image.c / /") -lm 2> "$TMP/err"; then
     "$TMP/test_io"
   else
     bad "tests/test_io.c $paths compiles: $(head -3 "$TMP/err")"
@@ -144,7 +145,7 @@ done
 [ $rc = 0 ] && grep -qE "^ray [0-9]+\.[0-9]+" "$TMP/out.txt" && ok "--version: $(cat "$TMP/out.txt")" \
   || bad "--version: exit $rc, $(cat "$TMP/out.txt")"
 # -t without OpenMP: one warning however often -t is given; with it, none.
-if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c kdtree.c bvh.c grid.c -lm 2> "$TMP/err"; then
+if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c $RAY_PARTS -lm 2> "$TMP/err"; then
   "$TMP/ray_serial" -t 2 -t 3 -s 4x4 -o "$TMP/t.ppm" scenes/whitted.sph 2> "$TMP/err"
   [ "$(grep -c "warning: -t 3 is ignored" "$TMP/err")" = 1 ] && [ "$(wc -l < "$TMP/err")" = 1 ] \
     && ok "-t without OpenMP warns once: $(cat "$TMP/err")" || bad "-t without OpenMP: $(cat "$TMP/err")"

@@ -6,7 +6,7 @@
 
 if ! $CC $CFLAGS -Dmalloc=kdb_malloc -Drealloc=kdb_realloc -Dfree=kdb_free \
        -c kdtree.c -o "$TMP/kd_counted.o" 2>"$TMP/cc.err" \
-   || ! $CC $CFLAGS -o "$TMP/test_kdbuild" tests/test_kdbuild.c "$TMP/kd_counted.o" bvh.c grid.c -lm 2>>"$TMP/cc.err"; then
+   || ! $CC $CFLAGS -o "$TMP/test_kdbuild" tests/test_kdbuild.c "$TMP/kd_counted.o" $(echo " $RAY_PARTS " | sed "s/ kdtree.c / /") -lm 2>>"$TMP/cc.err"; then
   bad "test_kdbuild builds: $(head -c 300 "$TMP/cc.err" | tr '\n' ' ')"
   exit 1
 fi

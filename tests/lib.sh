@@ -6,5 +6,8 @@ bad() { echo "FAIL $*"; }
 check() { local name=$1; shift; if "$@" >/dev/null 2>&1; then ok "$name"; else bad "$name"; fi; }
 CC=${CC:-cc}
 CFLAGS=${CFLAGS:--O2}
+# What a program that includes ray.c whole links beside it (the Makefile's
+# RAY_PARTS); word-split on purpose where it is used.
+RAY_PARTS=${RAY_PARTS:-scene.c image.c cli.c kdtree.c bvh.c grid.c}
 export TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT

@@ -1,7 +1,7 @@
 # The path tracer: analytic answers (tests/test_pt.c includes ray.c whole),
 # and what the program promises of its output.
 . tests/lib.sh
-$CC $CFLAGS -std=c99 -o "$TMP/test_pt" tests/test_pt.c kdtree.c bvh.c grid.c -lm || { bad "tests/test_pt.c compiles"; exit 1; }
+$CC $CFLAGS -std=c99 -o "$TMP/test_pt" tests/test_pt.c $RAY_PARTS -lm || { bad "tests/test_pt.c compiles"; exit 1; }
 "$TMP/test_pt"
 
 # The same bytes on 1 and 2 threads: a pixel's random numbers are a hash of

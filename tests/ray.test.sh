@@ -2,8 +2,8 @@
 # in the double build and, for what it must keep (triangles at every scale,
 # watertightness near and far, the tree against the loop), the float build.
 . tests/lib.sh
-$CC $CFLAGS -std=c99 -o "$TMP/test_ray" tests/test_ray.c kdtree.c bvh.c grid.c -lm || { bad "tests/test_ray.c compiles"; exit 1; }
+$CC $CFLAGS -std=c99 -o "$TMP/test_ray" tests/test_ray.c $RAY_PARTS -lm || { bad "tests/test_ray.c compiles"; exit 1; }
 "$TMP/test_ray"
-$CC $CFLAGS -std=c99 -DREAL=float -o "$TMP/test_ray_float" tests/test_ray.c kdtree.c bvh.c grid.c -lm ||
+$CC $CFLAGS -std=c99 -DREAL=float -o "$TMP/test_ray_float" tests/test_ray.c $RAY_PARTS -lm ||
   { bad "tests/test_ray.c compiles with -DREAL=float"; exit 1; }
 "$TMP/test_ray_float"

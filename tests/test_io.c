@@ -1,11 +1,14 @@
-/* Unit tests for ray.c's plumbing of issue 13: the sRGB curve, the PNG
- * writer's checksums, extensions, and how paths are split (built once as is
- * and once with -DRAY_DOS_PATHS, the Windows rule).  ray.c is included whole
- * so that its static functions can be called; its main() is renamed out of
- * the way.  Prints "PASS name" / "FAIL name" lines for tests/run.sh. */
+/* Unit tests for the plumbing: the sRGB curve (ray.c), the PNG writer's
+ * checksums (image.c), extensions, and how paths are split (scene.c and
+ * cli.c; built once as is and once with -DRAY_DOS_PATHS, the Windows rule).
+ * ray.c and image.c are included whole so that their static functions can
+ * be called (the test links the other parts, not image.c); ray.c's main()
+ * is renamed out of the way.  Prints "PASS name" / "FAIL name" lines for
+ * tests/run.sh. */
 #define main ray_main
 #include "../ray.c"
 #undef main
+#include "../image.c"
 
 static int failures;
 

@@ -394,7 +394,7 @@ static void test_ears(void)
                     vec p = s.vert[vi[k]], q = s.vert[vi[(k + 1) % n]];
                     area += 0.5 * dot(cross(p, q), f->n);
                 }
-                triangulate(&s, vi, NULL, n, 0);
+                triangulate((scene_builder[]){ builder(&s) }, vi, NULL, n, 0);
                 most = busiest_vertex(&s);
                 for (k = 0; k < s.ntri; k++) {
                     double t = 0.5 * dot(cross(s.tri[k].e1, s.tri[k].e2), f->n);

@@ -69,7 +69,7 @@ static void camera(Scene *s, vec eye, vec at, vec up, double fov)
     real v[10];
     v[0] = eye.x; v[1] = eye.y; v[2] = eye.z; v[3] = at.x; v[4] = at.y; v[5] = at.z;
     v[6] = up.x; v[7] = up.y; v[8] = up.z; v[9] = fov;
-    set_camera(s, (Where){ "", 0 }, v);
+    set_camera(s, v, (char[SCENE_WHY]){ 0 });
 }
 
 /* The scene made ready for the path tracer: estimator, roulette, a bound

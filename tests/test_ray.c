@@ -553,7 +553,7 @@ static void test_tree_image(const char *accel)
     add_light(&s, v3(-5, -4, 9), v3(0.5, 0.5, 0.5), -1);
     add_light(&s, v3(0.3, 0.2, 0.6), v3(0.4, 0.4, 0.4), -1);
     add_light(&s, v3(-1.5, 1.1, 0.4), v3(0.3, 0.3, 0.3), -1);
-    set_camera(&s, (Where){ "", 0 }, v);
+    set_camera(&s, v, (char[SCENE_WHY]){ 0 });
     build_accel(&s, accel);
     used = s.accel;
     for (j = 0; j < W; j++) {
@@ -676,7 +676,7 @@ static void test_light_under_ceiling(void)
     }
     add_sphere(&s, ball, 0.5, 0);
     add_light(&s, light, v3(1, 1, 1), -1);
-    set_camera(&s, (Where){ "", 0 }, v);
+    set_camera(&s, v, (char[SCENE_WHY]){ 0 });
     build_accel(&s, "kd");
     for (accel = 0; accel < 2; accel++) {
         int wrong = 0, lit = 0, dark = 0;
@@ -751,7 +751,7 @@ static void test_ear_clipping(void)
             vec a = s.vert[vi[k]], b = s.vert[vi[(k + 1) % n]];
             area += 0.5 * (a.z * b.x - a.x * b.z);
         }
-        triangulate(&s, vi, NULL, n, 0);
+        triangulate((scene_builder[]){ builder(&s) }, vi, NULL, n, 0);
         for (k = 0; k < s.ntri; k++) sum += tri_area(&s, k);
         report(s.ntri == n - 2 && near(sum, fabs(area), 1e-12 * fabs(area)),
                shape ? "ear clipping a 40-gon comb: n-2 triangles, area exact" :
@@ -770,7 +770,7 @@ static void test_convex_polygon(void)
     int n = 4000, k, *vi = malloc(sizeof *vi * n), *uses = calloc(n, sizeof *uses), most = 0;
     double sum = 0, area = 0.5 * n * sin(2 * PI / n);
     for (k = 0; k < n; k++) vi[k] = add_vertex(&s, v3(cos(2 * PI * k / n), sin(2 * PI * k / n), 0));
-    triangulate(&s, vi, NULL, n, 0);
+    triangulate((scene_builder[]){ builder(&s) }, vi, NULL, n, 0);
     for (k = 0; k < s.ntri; k++) {
         int j;
         sum += tri_area(&s, k);
@@ -906,7 +906,7 @@ static void test_camera(void)
     double angle;
     real v[10] = { 0, 0, 0, 0, 1, 0, 0, 0, 1, 60 };
     default_scene(&s);
-    set_camera(&s, (Where){ "", 0 }, v);
+    set_camera(&s, v, (char[SCENE_WHY]){ 0 });
     c = camera_ray(&s.cam, 640, 480, 320, 240);
     e = camera_ray(&s.cam, 640, 480, 0, 240);
     angle = acos(dot(c.d, e.d)) * 180 / PI;
@@ -948,7 +948,7 @@ static int acne_at_scale(double k, int *counted)
     l = &s.light[0];
     v[0] = 0; v[1] = -8 * k; v[2] = 5 * k; v[3] = 0; v[4] = 0; v[5] = 0;
     v[6] = 0; v[7] = 0; v[8] = 1; v[9] = 50;
-    set_camera(&s, (Where){ "", 0 }, v);
+    set_camera(&s, v, (char[SCENE_WHY]){ 0 });
     *counted = 0;
     for (j = 0; j < W; j++)
         for (i = 0; i < W; i++) {
@@ -999,7 +999,7 @@ static int lone_acne(int cylinder, double k, double far, int *counted)
     add_light(&s, v3(0.5 * far * k, -far * k, 0.3 * far * k), v3(1, 1, 1), -1);
     v[0] = 0; v[1] = -far * k; v[2] = 0; v[3] = 0; v[4] = 0; v[5] = 0;
     v[6] = 0; v[7] = 0; v[8] = 1; v[9] = 2 * atan(1.5 / far) * 180 / PI;
-    set_camera(&s, (Where){ "", 0 }, v);
+    set_camera(&s, v, (char[SCENE_WHY]){ 0 });
     *counted = 0;
     for (j = 0; j < W; j++)
         for (i = 0; i < W; i++) {
