@@ -282,7 +282,21 @@ typedef struct {
     unsigned long long key;     /* the path tracer's random numbers: which sample, */
     unsigned dim;               /* and how many it has drawn (see random01) */
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
+    const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
+    long long *splat;           /* this thread's splat image (see splat()), or NULL */
 } Worker;
+
+/* Two hooks in render() for the integrators still to come.  prepass runs
+ * once before the pixels (photon mapping shoots its photons there, into
+ * data).  after_sample runs after each sample k of pixel (i, j) and may add
+ * light to any pixel by splat() (light tracing's paths reach the camera
+ * wherever they land, not in the pixel that started them).  Both NULL: a
+ * plain render. */
+typedef struct Hooks {
+    void (*prepass)(const Scene *s, void *data);
+    void (*after_sample)(const Scene *s, int i, int j, int k, Worker *wk, void *data);
+    void *data;
+} Hooks;
 
 /* The image being made (image.h): bytes (for PPM and PNG), or floats (for
  * PFM), row by row from the top-left, three channels a pixel. */
@@ -444,6 +458,7 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
         wk->count.primary++;
         wk->budget = RAY_BUDGET;
         sum = add(sum, trace(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), s->depth, 1, wk));
+        if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
     return scale((real)1 / spp, sum);
 }
@@ -697,6 +712,7 @@ static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk)
         L = sample_radiance(s, i, j, k, wk);
         if (isfinite(L.x) && isfinite(L.y) && isfinite(L.z)) sum = add(sum, L);
         else wk->count.discarded++;
+        if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
     return scale((real)1 / spp, sum);
 }
@@ -1867,6 +1883,7 @@ static int degenerate(vec a, vec b, vec c)
 typedef struct {
     int spp, threads, progress;
     double start;                 /* when the render began (now()), for the progress line */
+    const Hooks *hooks;           /* NULL: none */
 } Options;
 
 /* Seconds on a wall clock (processor time where there is none: with threads
@@ -1920,32 +1937,104 @@ static void add_counts(Counts *to, const Counts *from)
     if (from->threads > to->threads) to->threads = from->threads;
 }
 
+/* The rows in the order they are handed out: k-th row j = k * stride mod h,
+ * for a stride near h / golden ratio with no factor in common with h, so
+ * that the rows done at any moment are spread over the image and the
+ * progress line's estimate is fair (the Cornell box's top rows, its black
+ * ceiling around the lamp, take a fraction of the time of the rest). */
+static int row_stride(int h)
+{
+    int a, b, stride = (int)(h * 0.6180339887) | 1;
+    for (;; stride++) {
+        for (a = stride, b = h; b; ) { int r = a % b; a = b; b = r; }
+        if (a == 1) return stride;
+    }
+}
+
+/* The splat image's fixed point: 2^32 units a unit of radiance.  Integers
+ * add exactly in any order, so what many threads splat into their own
+ * images sums to the same bytes for any number of threads and any order of
+ * rows, which float sums would not. */
+#define SPLAT_ONE 4294967296.0
+#define SPLAT_MAX 1048576.0         /* a larger splat is clamped: no overflow */
+
+/* Light L added to the pixel under image point (x, y), by a sample of any
+ * pixel (a hook's after_sample).  Not static: nothing in ray.c calls it
+ * yet (light tracing will), and the tests do. */
+void splat(const Scene *s, Worker *wk, real x, real y, vec L);
+void splat(const Scene *s, Worker *wk, real x, real y, vec L)
+{
+    double c[3];
+    int a, i = (int)floor(x), j = (int)floor(y);
+    if (!wk->splat || i < 0 || j < 0 || i >= s->w || j >= s->h) return;
+    to3(L, c);
+    for (a = 0; a < 3; a++)
+        if (c[a] > 0)               /* NaN too is left out */
+            wk->splat[3 * ((size_t)j * s->w + i) + a] += (long long)(fmin(c[a], SPLAT_MAX) * SPLAT_ONE);
+}
+
+/* Every thread's splats summed, then added to the image of the pixels'
+ * own estimates (floats, own) as light per sample, into img. */
+static void add_splats(const Scene *s, const Options *o, long long **splats, int nthreads,
+                       const Image *own, Image *img)
+{
+    size_t at, n = (size_t)s->w * s->h;
+    int t, i, j;
+    for (at = 0; at < 3 * n; at++)
+        for (t = 1; t < nthreads; t++) splats[0][at] += splats[t][at];
+    for (j = 0; j < s->h; j++)
+        for (i = 0; i < s->w; i++) {
+            const float *f = own->floats + 3 * ((size_t)j * s->w + i);
+            const long long *q = splats[0] + 3 * ((size_t)j * s->w + i);
+            put_pixel(img, i, j, v3((real)(f[0] + q[0] / SPLAT_ONE / o->spp),
+                                    (real)(f[1] + q[1] / SPLAT_ONE / o->spp),
+                                    (real)(f[2] + q[2] / SPLAT_ONE / o->spp)));
+        }
+}
+
 /* The whole image, row by row (render_row).  Rows go to threads one at a
  * time, as they free up; each pixel is written once by whoever computes it,
  * so the image does not depend on the order.  Each thread has its own
- * Worker; their counts are summed into *total. */
+ * Worker; their counts are summed into *total.  With o->hooks, the
+ * pre-pass runs first, and splats go to each thread's own splat image,
+ * added to the pixels at the end (add_splats). */
 static void render(const Scene *s, const Options *o, Image *img, Counts *total)
 {
-    int done = 0;
+    int done = 0, stride = row_stride(s->h), nthreads = 1, splats = o->hooks && o->hooks->after_sample;
+    long long **splat = NULL;
+    Image own = *img;
 #ifdef _OPENMP
     if (o->threads > 0) omp_set_num_threads(o->threads);
+    nthreads = o->threads > 0 ? o->threads : omp_get_max_threads();
 #endif
-    OMP(omp parallel)
+    if (o->hooks && o->hooks->prepass) o->hooks->prepass(s, o->hooks->data);
+    if (splats) {
+        int t;
+        splat = calloc((size_t)nthreads, sizeof *splat);
+        if (!splat || !new_image(&own, s->w, s->h, 1, 0)) out_of_memory();
+        for (t = 0; t < nthreads; t++)
+            if (!(splat[t] = calloc((size_t)s->w * s->h * 3, sizeof **splat))) out_of_memory();
+    }
+    OMP(omp parallel num_threads(nthreads))
     {
         Worker wk;
-        int j;
+        int k;
         memset(&wk, 0, sizeof wk);
         wk.count.threads = 1;
+        wk.hooks = o->hooks;
 #ifdef _OPENMP
         wk.count.threads = omp_get_num_threads();
+        if (splats) wk.splat = splat[omp_get_thread_num()];
+#else
+        if (splats) wk.splat = splat[0];
 #endif
         OMP(omp for schedule(dynamic, 1))
-        for (j = 0; j < s->h; j++) {
+        for (k = 0; k < s->h; k++) {
             int i, mine;
             /* a row starts with an empty shadow cache, so that the counts
              * do not depend on which thread had the row before */
             for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
-            render_row(s, j, o->spp, img, &wk);
+            render_row(s, (int)((long long)k * stride % s->h), o->spp, &own, &wk);
             OMP(omp atomic capture)
             mine = ++done;
             if (o->progress && (mine * 100 / s->h != (mine - 1) * 100 / s->h))
@@ -1953,6 +2042,13 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         }
         OMP(omp critical)
         add_counts(total, &wk.count);
+    }
+    if (splats) {
+        int t;
+        add_splats(s, o, splat, nthreads, &own, img);
+        for (t = 0; t < nthreads; t++) free(splat[t]);
+        free(splat);
+        free_image(&own);
     }
     if (o->progress) fprintf(stderr, "\r%30s\r", "");
 }
@@ -2004,7 +2100,9 @@ static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
 {
     Counts before = wk->count;
     Hit h;
-    int hit = nearest_hit(s, camera_ray(&s->cam, s->w, s->h, i + (real)0.5, j + (real)0.5), &h, wk);
+    int hit;
+    wk->count.primary++;
+    hit = nearest_hit(s, camera_ray(&s->cam, s->w, s->h, i + (real)0.5, j + (real)0.5), &h, wk);
     if (s->view == VIEW_STEPS)
         return heat((real)(wk->count.steps - before.steps + wk->count.tests - before.tests));
     if (!hit) return v3(0, 0, 0);
