@@ -7,14 +7,7 @@
 #include "../ray.c"
 #undef main
 
-static int failures;
-
-static void check(int ok, const char *name)
-{
-    printf("%s %s\n", ok ? "PASS" : "FAIL", name);
-    fflush(stdout);
-    failures += !ok;
-}
+#include "check.h"
 
 /* What the hooks saw. */
 typedef struct { int prepasses, early; } Seen;

@@ -10,14 +10,7 @@
 #undef main
 #include "../image.c"
 
-static int failures;
-
-static void check(int ok, const char *name)
-{
-    printf("%s %s\n", ok ? "PASS" : "FAIL", name);
-    fflush(stdout);
-    failures += !ok;
-}
+#include "check.h"
 
 /* The curve of IEC 61966-2-1 at points worked out by hand: its ends, where
  * the line meets the power (0.0031308 -> 0.04045, continuous to 1e-7),
