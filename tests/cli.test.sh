@@ -179,3 +179,33 @@ printf 'v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 8 8\n
 ./ray -s 4x4 -o "$TMP/i.ppm" "$TMP/ior.nff" 2>"$TMP/err"; rc=$?
 [ $rc = 1 ] && grep -q "ior.nff:8: index of refraction must be between 1e-6 and 1e6" "$TMP/err" \
   && ok "an index of refraction of 3.3e16 is refused at its line" || bad "index 3.3e16: exit $rc, $(cat "$TMP/err")"
+
+# The option text has one copy, cli.c's usage(): the README shows it as
+# --help prints it (the block after "./ray --help` prints the options").
+awk '/`\.\/ray --help` prints the options/ { f = 1; next } f && /^```$/ { if (in_block) exit; in_block = 1; next } in_block' README.md >"$TMP/readme_help"
+./ray --help >"$TMP/help"
+if [ -s "$TMP/readme_help" ] && cmp -s "$TMP/help" "$TMP/readme_help"; then
+  ok "the README shows ./ray --help as it prints"
+else
+  bad "the README's option text differs from ./ray --help: $(diff "$TMP/help" "$TMP/readme_help" | head -5 | tr '\n' ' ')"
+fi
+./ray --version | grep -q "Whitted's ray tracer and Kajiya's path tracer" && ok "--version names both renderers" \
+  || bad "--version: $(./ray --version)"
+./ray --help | grep -q -- "--version" && ok "--help lists --version" || bad "--help does not list --version"
+./ray --seed 0 -s 4x4 --pt -o "$TMP/s0.ppm" scenes/cornell.sph 2>/dev/null && ./ray -s 4x4 --pt -o "$TMP/sd.ppm" scenes/cornell.sph 2>/dev/null \
+  && cmp -s "$TMP/s0.ppm" "$TMP/sd.ppm" && ok "--seed 0 is taken, and is the default noise" || bad "--seed 0 refused, or not the default"
+./ray --no-roulette --pt -s 4x4 -o "$TMP/nr.ppm" scenes/cornell.sph 2>/dev/null; rc=$?
+[ "$rc" = 2 ] && ok "--no-roulette without -d is a usage error (exit 2)" || bad "--no-roulette without -d exits $rc, not 2"
+./ray -s 8x8 --stats=kv -o "$TMP/kv.ppm" scenes/whitted.sph 2>"$TMP/kv"
+./ray -s 8x8 --stats -o "$TMP/kv.ppm" scenes/whitted.sph 2>"$TMP/prose"
+if [ "$(awk '$1 == "rays" { print $2 }' "$TMP/kv")" = "$(sed -n 's/^rays *\([0-9]*\):.*/\1/p' "$TMP/prose")" ] \
+   && [ "$(awk '$1 == "hits" { print $2 }' "$TMP/kv")" = "$(awk '$1 == "hits" { print $2 }' "$TMP/prose")" ] \
+   && awk 'NF != 2 { bad = 1 } END { exit bad }' "$TMP/kv"; then
+  ok "--stats=kv: one key and one value a line, the rays and hits of --stats"
+else
+  bad "--stats=kv: $(head -3 "$TMP/kv" | tr '\n' ' ')"
+fi
+./ray --view steps -s 8x8 --stats=kv -o "$TMP/v.ppm" scenes/whitted.sph 2>&1 | grep -q '^rays 64$' \
+  && ok "--view counts its rays (64 for 8x8)" || bad "--view with --stats counts no rays"
+./ray -s 8x8 --stats -o "$TMP/c.ppm" scenes/cornell.sph 2>&1 | grep -q '0 point lights, 2 glowing' \
+  && ok "--stats: the Cornell box has 0 point lights and 2 glowing triangles" || bad "--stats scene line on the Cornell box"
