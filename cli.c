@@ -250,3 +250,113 @@ int parse_args(int argc, char **argv, Args *a)
     warn_threads(a->threads);
     return -1;
 }
+
+static unsigned long long all_rays(const Stats *st)
+{
+    return st->primary + st->shadow + st->reflected + st->refracted + st->bounced;
+}
+
+/* --stats=kv: for programs to read (bench/run.sh does). */
+static void print_stats_kv(FILE *f, const Stats *st)
+{
+    static const char *const estimators[] = { "bsdf", "nee", "mis" };
+    fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
+            st->spheres, st->cones, st->triangles, st->point_lights, st->glowing);
+    fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", st->w, st->h, st->spp,
+            st->threads, st->path ? "path" : "whitted");
+    if (st->path)
+        fprintf(f, "estimator %s\nroulette %d\nmax_rays %d\nseed %u\nlights %d\n", estimators[st->estimator],
+                st->roulette, st->max_rays, st->seed, st->lights);
+    else
+        fprintf(f, "depth %d\n", st->depth);
+    fprintf(f, "accel %s\n", st->accel);
+    if (!strcmp(st->accel, "kd"))
+        fprintf(f, "accel_nodes %ld\naccel_leaves %ld\naccel_empty_leaves %ld\naccel_depth %ld\n"
+                "accel_prims_per_leaf %.4f\naccel_bytes %.0f\naccel_sah_cost %.4f\n", st->kd.nodes,
+                st->kd.leaves, st->kd.empty_leaves, st->kd.max_depth, st->kd.prims_per_leaf,
+                (double)st->kd.bytes, st->kd.sah_cost);
+    else if (!strcmp(st->accel, "bvh"))
+        fprintf(f, "accel_nodes %ld\naccel_leaves %ld\naccel_depth %ld\naccel_prims_per_leaf %.4f\n"
+                "accel_bytes %lu\naccel_sah_cost %.4f\n", st->bvh.nodes, st->bvh.leaves,
+                st->bvh.max_depth, st->bvh.prims_per_leaf, (unsigned long)st->bvh.bytes,
+                st->bvh.sah_cost);
+    else if (!strcmp(st->accel, "grid"))
+        fprintf(f, "grid_cells %dx%dx%d\naccel_empty_cells %ld\naccel_refs %ld\naccel_bytes %lu\n",
+                st->grid.res[0], st->grid.res[1], st->grid.res[2], st->grid.empty_cells,
+                (long)st->grid.prim_refs, (unsigned long)st->grid.bytes);
+    fprintf(f, "rays %llu\nrays_primary %llu\nrays_shadow %llu\nrays_reflected %llu\n"
+            "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
+            all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced,
+            st->cut, st->discarded);
+    fprintf(f, "queries %llu\nnearest_queries %llu\nhits %llu\ntests %llu\nsteps %llu\n",
+            st->queries, st->nearest, st->hits, st->tests, st->steps);
+    fprintf(f, "load_s %.6f\nbuild_s %.6f\nrender_s %.6f\ncpu_s %.6f\n", st->load, st->build,
+            st->seconds, st->cpu);
+}
+
+/* The structure's line of --stats, in words. */
+static void print_accel(FILE *f, const Stats *st)
+{
+    if (!strcmp(st->accel, "kd"))
+        fprintf(f, "kd-tree    %ld nodes, %ld leaves (%ld empty), depth %ld,"
+                " %.2f objects per leaf,\n"
+                "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
+                st->kd.nodes, st->kd.leaves, st->kd.empty_leaves, st->kd.max_depth,
+                st->kd.prims_per_leaf, st->kd.bytes / 1e6, st->kd.sah_cost, st->build);
+    else if (!strcmp(st->accel, "bvh"))
+        fprintf(f, "bvh        %ld nodes, %ld leaves, depth %ld, %.2f objects per leaf,\n"
+                "           %lu bytes, SAH cost %.2f, built in %.3f s\n",
+                st->bvh.nodes, st->bvh.leaves, st->bvh.max_depth, st->bvh.prims_per_leaf,
+                (unsigned long)st->bvh.bytes, st->bvh.sah_cost, st->build);
+    else if (!strcmp(st->accel, "grid"))
+        fprintf(f, "grid       %dx%dx%d cells (%ld empty), %.2f references per object,\n"
+                "           %lu bytes, built in %.3f s\n", st->grid.res[0], st->grid.res[1],
+                st->grid.res[2], st->grid.empty_cells,
+                st->objects ? (double)st->grid.prim_refs / st->objects : 0.0,
+                (unsigned long)st->grid.bytes, st->build);
+    else
+        fprintf(f, "accel      none: every ray tests every object\n");
+}
+
+void print_stats(FILE *f, const Stats *st, int kv)
+{
+    static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
+                                              "MIS (BSDF sampling and next-event estimation)" };
+    unsigned long long rays = all_rays(st);
+    if (kv) {
+        print_stats_kv(f, st);
+        return;
+    }
+    fprintf(f, "scene      %d spheres, %d cones, %d triangles, %d point lights, %d glowing;"
+            " read in %.3f s\n", st->spheres, st->cones, st->triangles, st->point_lights,
+            st->glowing, st->load);
+    if (st->path)
+        fprintf(f, "image      %dx%d, %d spp, path traced, %d thread%s\n", st->w, st->h, st->spp,
+                st->threads, st->threads == 1 ? "" : "s");
+    else
+        fprintf(f, "image      %dx%d, %d spp, depth %d, %d thread%s\n", st->w, st->h, st->spp,
+                st->depth, st->threads, st->threads == 1 ? "" : "s");
+    print_accel(f, st);
+    if (st->path) {
+        char bound[32] = "none but roulette";
+        if (st->max_rays) sprintf(bound, "%d rays", st->max_rays);
+        fprintf(f, "paths      %s, roulette %s, length bound %s, seed %u, %d lights\n",
+                estimators[st->estimator],
+                st->roulette ? "on" : "off", bound, st->seed, st->lights);
+        fprintf(f, "rays       %llu: %llu primary, %llu shadow, %llu bounced\n",
+                rays, st->primary, st->shadow, st->bounced);
+        fprintf(f, "samples    %llu discarded (not finite)\n", st->discarded);
+    } else
+        fprintf(f, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
+                rays, st->primary, st->shadow, st->reflected, st->refracted);
+    if (!st->path && st->cut)
+        fprintf(f, "budget     %llu reflected or refracted rays not traced: past %d a primary ray\n",
+                st->cut, st->budget);
+    fprintf(f, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
+            st->nearest ? 100.0 * st->hits / (double)st->nearest : 0.0);
+    fprintf(f, "per ray    %.2f intersection tests, %.2f tree steps\n",
+            st->queries ? (double)st->tests / st->queries : 0.0,
+            st->queries ? (double)st->steps / st->queries : 0.0);
+    fprintf(f, "time       %.3f s, %.2f Mrays/s (CPU %.3f s, all threads)\n", st->seconds,
+            st->seconds > 0 ? rays / st->seconds * 1e-6 : 0.0, st->cpu);
+}

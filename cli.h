@@ -10,6 +10,9 @@
 #define CLI_H
 
 #include <stdio.h>
+#include "kdtree.h"
+#include "bvh.h"
+#include "grid.h"
 
 typedef struct {
     const char *scene;      /* the scene file */
@@ -38,5 +41,27 @@ int parse_args(int argc, char **argv, Args *a);
 char *default_output(const char *scene);
 
 void usage(FILE *to);
+
+/* What a render measured, for --stats: the scene, the image, the
+ * structure, the rays by kind and the time. */
+typedef struct {
+    int spheres, cones, triangles, objects, point_lights, glowing;
+    int w, h, spp, threads, path, depth;
+    int estimator;                  /* the path tracer's, as Args has it: 0 bsdf, 1 nee, 2 mis */
+    int roulette, max_rays, lights; /* lights: the path tracer's, the sky included */
+    unsigned seed;
+    const char *accel;              /* none, kd, bvh or grid: which of these is filled */
+    kd_info kd;
+    bvh_info bvh;
+    grid_info grid;
+    unsigned long long primary, shadow, reflected, refracted, bounced, cut, discarded;
+    unsigned long long queries, nearest, hits, tests, steps;
+    int budget;                     /* Whitted: secondary rays a primary ray may spawn */
+    double load, build, seconds, cpu;   /* seconds: reading, building, rendering; cpu: rendering */
+} Stats;
+
+/* In words, or with kv as `key value` lines, one a line (the README lists
+ * the keys). */
+void print_stats(FILE *f, const Stats *st, int kv);
 
 #endif

@@ -2540,128 +2540,31 @@ static int glowing(const Scene *s)
     return n;
 }
 
-static int point_lights(const Scene *s)
-{
-    int i, n = 0;
-    for (i = 0; i < s->nlight; i++) n += s->light[i].sphere < 0;
-    return n;
-}
-
-static unsigned long long all_rays(const Counts *st)
-{
-    return st->primary + st->shadow + st->reflected + st->refracted + st->bounced;
-}
-
-/* --stats=kv: the figures of --stats as `key value` lines, one a line, for
- * programs to read (bench/run.sh does); the README lists the keys. */
-static void print_stats_kv(const Scene *s, const Counts *st, int spp, double load, double build,
-                           double seconds, double cpu)
+/* What --stats prints (cli.c prints it, in words or as key value lines). */
+static void report_stats(const Scene *s, const Counts *c, int spp, int kv, double load,
+                         double build, double seconds, double cpu)
 {
     static const char *const accels[] = { "none", "kd", "bvh", "grid" };
-    static const char *const estimators[] = { "bsdf", "nee", "mis" };
-    FILE *f = stderr;
-    fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
-            s->nsph, s->ncone, s->ntri, point_lights(s), glowing(s));
-    fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", s->w, s->h, spp,
-            st->threads, s->integrator == PATH ? "path" : "whitted");
-    if (s->integrator == PATH)
-        fprintf(f, "estimator %s\nroulette %d\nmax_rays %d\nseed %u\nlights %d\n",
-                estimators[s->estimator], s->roulette, s->max_rays, s->seed, s->nemit);
-    else
-        fprintf(f, "depth %d\n", s->depth);
-    fprintf(f, "accel %s\n", accels[s->accel]);
-    if (s->accel == ACCEL_KD) {
-        kd_info k;
-        kd_describe(s->kd, &k);
-        fprintf(f, "accel_nodes %ld\naccel_leaves %ld\naccel_empty_leaves %ld\naccel_depth %ld\n"
-                "accel_prims_per_leaf %.4f\naccel_bytes %.0f\naccel_sah_cost %.4f\n", k.nodes,
-                k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf, (double)k.bytes, k.sah_cost);
-    } else if (s->accel == ACCEL_BVH) {
-        bvh_info b;
-        bvh_describe(s->bvh, &b);
-        fprintf(f, "accel_nodes %ld\naccel_leaves %ld\naccel_depth %ld\naccel_prims_per_leaf %.4f\n"
-                "accel_bytes %lu\naccel_sah_cost %.4f\n", b.nodes, b.leaves, b.max_depth,
-                b.prims_per_leaf, (unsigned long)b.bytes, b.sah_cost);
-    } else if (s->accel == ACCEL_GRID) {
-        grid_info g;
-        grid_describe(s->grid, &g);
-        fprintf(f, "grid_cells %dx%dx%d\naccel_empty_cells %ld\naccel_refs %ld\naccel_bytes %lu\n",
-                g.res[0], g.res[1], g.res[2], g.empty_cells, (long)g.prim_refs, (unsigned long)g.bytes);
-    }
-    fprintf(f, "rays %llu\nrays_primary %llu\nrays_shadow %llu\nrays_reflected %llu\n"
-            "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
-            all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced, st->cut,
-            st->discarded);
-    fprintf(f, "queries %llu\nnearest_queries %llu\nhits %llu\ntests %llu\nsteps %llu\n",
-            st->queries, st->nearest, st->hits, st->tests, st->steps);
-    fprintf(f, "load_s %.6f\nbuild_s %.6f\nrender_s %.6f\ncpu_s %.6f\n", load, build, seconds, cpu);
-}
-
-/* --stats: rays by kind, hits, the structure and the time, in words; with
- * kv, as print_stats_kv. */
-static void print_stats(const Scene *s, const Counts *st, int spp, int kv, double load,
-                        double build, double seconds, double cpu)
-{
-    static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
-                                              "MIS (BSDF sampling and next-event estimation)" };
-    unsigned long long rays = all_rays(st);
-    if (kv) {
-        print_stats_kv(s, st, spp, load, build, seconds, cpu);
-        return;
-    }
-    fprintf(stderr, "scene      %d spheres, %d cones, %d triangles, %d point lights, %d glowing;"
-            " read in %.3f s\n", s->nsph, s->ncone, s->ntri, point_lights(s), glowing(s), load);
-    if (s->integrator == PATH)
-        fprintf(stderr, "image      %dx%d, %d spp, path traced, %d thread%s\n", s->w, s->h, spp,
-                st->threads, st->threads == 1 ? "" : "s");
-    else
-        fprintf(stderr, "image      %dx%d, %d spp, depth %d, %d thread%s\n", s->w, s->h, spp,
-                s->depth, st->threads, st->threads == 1 ? "" : "s");
-    if (s->accel == ACCEL_KD) {
-        kd_info k;
-        kd_describe(s->kd, &k);
-        fprintf(stderr, "kd-tree    %ld nodes, %ld leaves (%ld empty), depth %ld,"
-                " %.2f objects per leaf,\n"
-                "           %.1f MB, SAH cost %.2f, built in %.3f s\n",
-                k.nodes, k.leaves, k.empty_leaves, k.max_depth, k.prims_per_leaf,
-                k.bytes / 1e6, k.sah_cost, build);
-    } else if (s->accel == ACCEL_BVH) {
-        bvh_info b;
-        bvh_describe(s->bvh, &b);
-        fprintf(stderr, "bvh        %ld nodes, %ld leaves, depth %ld, %.2f objects per leaf,\n"
-                "           %lu bytes, SAH cost %.2f, built in %.3f s\n",
-                b.nodes, b.leaves, b.max_depth, b.prims_per_leaf, (unsigned long)b.bytes,
-                b.sah_cost, build);
-    } else if (s->accel == ACCEL_GRID) {
-        grid_info g;
-        grid_describe(s->grid, &g);
-        fprintf(stderr, "grid       %dx%dx%d cells (%ld empty), %.2f references per object,\n"
-                "           %lu bytes, built in %.3f s\n", g.res[0], g.res[1], g.res[2],
-                g.empty_cells, nobj(s) ? (double)g.prim_refs / nobj(s) : 0.0,
-                (unsigned long)g.bytes, build);
-    } else
-        fprintf(stderr, "accel      none: every ray tests every object\n");
-    if (s->integrator == PATH) {
-        char bound[32] = "none but roulette";
-        if (s->max_rays) sprintf(bound, "%d rays", s->max_rays);
-        fprintf(stderr, "paths      %s, roulette %s, length bound %s, seed %u, %d lights\n",
-                estimators[s->estimator], s->roulette ? "on" : "off", bound, s->seed, s->nemit);
-        fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu bounced\n",
-                rays, st->primary, st->shadow, st->bounced);
-        fprintf(stderr, "samples    %llu discarded (not finite)\n", st->discarded);
-    } else
-        fprintf(stderr, "rays       %llu: %llu primary, %llu shadow, %llu reflected, %llu refracted\n",
-                rays, st->primary, st->shadow, st->reflected, st->refracted);
-    if (s->integrator != PATH && st->cut)
-        fprintf(stderr, "budget     %llu reflected or refracted rays not traced: past %d a primary ray\n",
-                st->cut, RAY_BUDGET);
-    fprintf(stderr, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
-            st->nearest ? 100.0 * st->hits / (double)st->nearest : 0.0);
-    fprintf(stderr, "per ray    %.2f intersection tests, %.2f tree steps\n",
-            st->queries ? (double)st->tests / st->queries : 0.0,
-            st->queries ? (double)st->steps / st->queries : 0.0);
-    fprintf(stderr, "time       %.3f s, %.2f Mrays/s (CPU %.3f s, all threads)\n", seconds,
-            seconds > 0 ? rays / seconds * 1e-6 : 0.0, cpu);
+    Stats st;
+    int i;
+    memset(&st, 0, sizeof st);
+    st.spheres = s->nsph, st.cones = s->ncone, st.triangles = s->ntri, st.objects = nobj(s);
+    for (i = 0; i < s->nlight; i++) st.point_lights += s->light[i].sphere < 0;
+    st.glowing = glowing(s);
+    st.w = s->w, st.h = s->h, st.spp = spp, st.threads = c->threads, st.depth = s->depth;
+    st.path = s->integrator == PATH;
+    st.estimator = s->estimator;
+    st.roulette = s->roulette, st.max_rays = s->max_rays, st.seed = s->seed, st.lights = s->nemit;
+    st.accel = accels[s->accel];
+    if (s->accel == ACCEL_KD) kd_describe(s->kd, &st.kd);
+    if (s->accel == ACCEL_BVH) bvh_describe(s->bvh, &st.bvh);
+    if (s->accel == ACCEL_GRID) grid_describe(s->grid, &st.grid);
+    st.primary = c->primary, st.shadow = c->shadow, st.reflected = c->reflected;
+    st.refracted = c->refracted, st.bounced = c->bounced, st.cut = c->cut, st.budget = RAY_BUDGET;
+    st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
+    st.hits = c->hits, st.tests = c->tests, st.steps = c->steps;
+    st.load = load, st.build = build, st.seconds = seconds, st.cpu = cpu;
+    print_stats(stderr, &st, kv);
 }
 
 static void free_scene(Scene *s)
@@ -2745,8 +2648,8 @@ int main(int argc, char **argv)
     t0 = now() - t0;
     ok = write_image(&out, &img, a.plain);
     if (a.stats)
-        print_stats(&s, &st, o.spp, a.stats == 2, load, build, t0,
-                    (double)(clock() - c0) / CLOCKS_PER_SEC);
+        report_stats(&s, &st, o.spp, a.stats == 2, load, build, t0,
+                     (double)(clock() - c0) / CLOCKS_PER_SEC);
     free_image(&img);
     free(a.made);
     free_scene(&s);
