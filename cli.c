@@ -5,8 +5,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #ifdef RAY_POSIX
 #include <sys/stat.h>
+#include <unistd.h>
 #endif
 #include "cli.h"
 #include "image.h"
@@ -359,4 +361,38 @@ void print_stats(FILE *f, const Stats *st, int kv)
             st->queries ? (double)st->steps / st->queries : 0.0);
     fprintf(f, "time       %.3f s, %.2f Mrays/s (CPU %.3f s, all threads)\n", st->seconds,
             st->seconds > 0 ? rays / st->seconds * 1e-6 : 0.0, st->cpu);
+}
+
+/* Seconds on a wall clock (processor time where there is none: with threads
+ * that overstates the time). */
+double now(void)
+{
+#ifdef RAY_POSIX
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+#else
+    return (double)clock() / CLOCKS_PER_SEC;
+#endif
+}
+
+int stderr_is_terminal(void)
+{
+#ifdef RAY_POSIX
+    return isatty(2);
+#else
+    return 0;
+#endif
+}
+
+/* "ray:  42%  ETA 1:05": rows done out of rows, and the time left if the
+ * rows still to do take as long as those done so far took. */
+void show_progress(double start, int done, int rows)
+{
+    long left = (long)((now() - start) * (rows - done) / done + 0.5);
+    if (left >= 3600)
+        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld:%02ld ", done * 100 / rows, left / 3600,
+                left / 60 % 60, left % 60);
+    else
+        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld    ", done * 100 / rows, left / 60, left % 60);
 }

@@ -42,6 +42,13 @@ char *default_output(const char *scene);
 
 void usage(FILE *to);
 
+/* Seconds on a wall clock (processor time where there is none). */
+double now(void);
+
+/* The progress line, "ray:  42%  ETA 1:05", goes to a terminal only. */
+int stderr_is_terminal(void);
+void show_progress(double start, int done, int rows);
+
 /* What a render measured, for --stats: the scene, the image, the
  * structure, the rays by kind and the time. */
 typedef struct {

@@ -109,9 +109,6 @@
 #include <stdint.h>
 #include <string.h>
 #include <time.h>
-#ifdef RAY_POSIX
-#include <unistd.h>
-#endif
 #include "prims.h"
 #include "kdtree.h"
 #include "bvh.h"
@@ -1886,40 +1883,6 @@ typedef struct {
     const Hooks *hooks;           /* NULL: none */
 } Options;
 
-/* Seconds on a wall clock (processor time where there is none: with threads
- * that overstates the time). */
-static double now(void)
-{
-#ifdef RAY_POSIX
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + ts.tv_nsec * 1e-9;
-#else
-    return (double)clock() / CLOCKS_PER_SEC;
-#endif
-}
-
-static int stderr_is_terminal(void)
-{
-#ifdef RAY_POSIX
-    return isatty(2);
-#else
-    return 0;
-#endif
-}
-
-/* "ray:  42%  ETA 1:05": rows done out of rows, and the time left if the
- * rows still to do take as long as those done so far took. */
-static void show_progress(const Options *o, int done, int rows)
-{
-    long left = (long)((now() - o->start) * (rows - done) / done + 0.5);
-    if (left >= 3600)
-        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld:%02ld ", done * 100 / rows, left / 3600,
-                left / 60 % 60, left % 60);
-    else
-        fprintf(stderr, "\rray: %3d%%  ETA %ld:%02ld    ", done * 100 / rows, left / 60, left % 60);
-}
-
 static void add_counts(Counts *to, const Counts *from)
 {
     to->primary += from->primary;
@@ -2038,7 +2001,7 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
             OMP(omp atomic capture)
             mine = ++done;
             if (o->progress && (mine * 100 / s->h != (mine - 1) * 100 / s->h))
-                show_progress(o, mine, s->h);
+                show_progress(o->start, mine, s->h);
         }
         OMP(omp critical)
         add_counts(total, &wk.count);
