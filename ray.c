@@ -233,6 +233,8 @@ enum { SPHERE, CONE, TRIANGLE };
 
 static int nobj(const Scene *s) { return s->nsph + s->ncone + s->ntri; }
 static void out_of_memory(void);        /* in the plumbing: says so, and exits */
+static void *grow(void *p, int *cap, int need, size_t size);    /* the plumbing: room for one more */
+static void add_light(Scene *s, vec pos, vec color, int sphere);  /* the plumbing: Whitted's lights */
 
 /* A ray: origin o, direction d, and skip, an object it cannot hit (or -1).
  * A ray leaving a flat triangle, or a sphere outward, never meets that
@@ -350,6 +352,7 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
 static void sample_offset(int k, real anchor, real *dx, real *dy);
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
+static int set_camera(Scene *s, const real *v, char *why);
 static void put_pixel(Image *img, int i, int j, vec c);
 static unsigned char to_byte(real v);
 static real srgb(real v);
@@ -396,6 +399,7 @@ static real random01(Worker *wk);
 
 /* finding hits: the only code that knows an acceleration structure exists */
 static int nearest_hit(const Scene *s, Ray r, Hit *h, Worker *wk);
+static int build_accel(Scene *s, const char *accel);
 static Query query(Ray r);
 static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk);
 static int prim_hit(void *user, int i, void *ray, double tmin, double tmax, double *t);
@@ -410,6 +414,7 @@ static int prim_clip(void *user, int i, const double blo[3], const double bhi[3]
                      double lo[3], double hi[3]);
 
 /* the primitives: each its hit test, its surface, its box and clip */
+static void add_sphere(Scene *s, vec cen, real rad, int mat);
 static real hit_sphere(const Sphere *sp, const Ray *r, real tmin);
 static void sphere_surface(const Sphere *sp, const Ray *r, real t, Hit *h);
 static void sphere_box(const Sphere *sp, double lo[3], double hi[3]);
@@ -417,9 +422,15 @@ static int sphere_clip(const Sphere *sp, const double blo[3], const double bhi[3
                        double lo[3], double hi[3]);
 static real sphere_sample(const Sphere *sp, vec x, real u, real v, vec *wi, real *dist);
 static real sphere_pdf(const Sphere *sp, vec x, vec y);
+static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat);
+static int check_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why);
 static real hit_cone(const Cone *c, const Ray *r, real tmin);
 static void cone_surface(const Cone *c, const Ray *r, real t, Hit *h);
 static void cone_box(const Cone *c, double lo[3], double hi[3]);
+static int add_vertex(Scene *s, vec p);
+static int add_normal(Scene *s, vec n);
+static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, int mat);
+static int degenerate(vec a, vec b, vec c);
 static int hit_triangle(const Scene *s, const Triangle *tr, const Ray *r, real tmax,
                         real *t, real *u, real *v);
 static void triangle_surface(const Scene *s, const Triangle *tr, real u, real v, Hit *h);
@@ -487,6 +498,65 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
                        scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
     r.tmin = c->hither > 0 ? c->hither / dot(r.d, c->fwd) : 0;
     return r;
+}
+
+/* The largest |coordinate| of a light or the camera: two points within it
+ * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
+ * takes between them (to a light, from the eye) stay finite; beyond it, a
+ * light would light nothing and an eye see nothing.  3.9e153 in doubles. */
+#define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
+
+static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
+
+/* a times the power of two that brings its largest coordinate into
+ * [1/2, 1): the same direction, and exactly the same unit() and cross()
+ * bits as a itself, yet no square of it overflows or underflows. */
+static vec pow2_scaled(vec a)
+{
+    int e;
+    real m = maxabs(a);
+    if (!(m > 0) || !isfinite(m)) return a;
+    frexp(m, &e);
+    return v3((real)ldexp(a.x, -e), (real)ldexp(a.y, -e), (real)ldexp(a.z, -e));
+}
+
+/* The narrowest field of view, in degrees, for which the image plane of
+ * camera_ray stays near enough to square its distance at 32768 pixels
+ * across: 2.8e-148 degrees in doubles. */
+static double narrowest_fov(void)
+{
+    return 2 * atan(16384 / (sqrt(sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 2))
+           * 180 / PI;
+}
+
+/* The camera at eye v[0..2] looking at v[3..5], up towards v[6..8], with a
+ * horizontal field of view of v[9] degrees. */
+static int set_camera(Scene *s, const real *v, char *why)
+{
+    Camera *c = &s->cam;
+    vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
+    c->eye = v3(v[0], v[1], v[2]);
+    if (!within_far_limit(c->eye) || !within_far_limit(at)) {
+        sprintf(why, "camera too far out: beyond %.2g, squared distances from the eye overflow",
+                (double)FAR_LIMIT);
+        return 0;
+    }
+    if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
+        return sprintf(why, "camera looks at its own eye"), 0;
+    if (!(v[9] > 0 && v[9] < 180))
+        return sprintf(why, "field of view must be between 0 and 180 degrees"), 0;
+    if (!(v[9] >= narrowest_fov())) {
+        sprintf(why, "field of view too narrow: under %.2g degrees the image plane is so far away"
+                " that its squared distance overflows", narrowest_fov());
+        return 0;
+    }
+    c->tan_half = tan(v[9] * PI / 360);
+    c->fwd = unit(pow2_scaled(sub(at, c->eye)));
+    c->right = cross(c->fwd, up);
+    if (!(dot(c->right, c->right) > 0)) return sprintf(why, "camera up is parallel to its view"), 0;
+    c->right = unit(c->right);
+    c->up = cross(c->right, c->fwd);
+    return 1;
 }
 
 /* The pixel into the image: as floats (for PFM, the radiance itself), or
@@ -1410,7 +1480,135 @@ static int prim_clip(void *user, int i, const double blo[3], const double bhi[3]
     return 1;
 }
 
+/* Which structure answers: built once, before the render. */
+
+/* From this many objects on, the tree pays; below, a loop over them all
+ * costs less than walking even a small tree.  Measured on scenes of random
+ * spheres, 800x800 at 8 samples, one thread: 5 spheres, the loop 12% faster;
+ * 8, even; 12 and 16, the tree 16% and 17% faster.  On the minray scene
+ * (5 spheres) the loop is 25% faster. */
+#define TREE_FROM 8
+
+/* Whether every object lies within the range the structures' float boxes
+ * and planes can hold (they clamp beyond FLT_MAX), with float precision to
+ * spare: coordinates below 1e37, and a scene that reaches beyond 1e-30
+ * of the origin (nearer, floats lose their bits to denormals). */
+static int float_range(const Scene *s)
+{
+    double lo[3], hi[3], big = 0;
+    int i, a;
+    for (i = 0; i < nobj(s); i++) {
+        prim_bounds((void *)s, i, lo, hi);
+        for (a = 0; a < 3; a++) big = fmax(big, fmax(fabs(lo[a]), fabs(hi[a])));
+    }
+    return nobj(s) == 0 || (big < 1e37 && big > 1e-30);
+}
+
+/* auto's probe: PROBE x PROBE pixels spread over the image, one sample
+ * each, rendered whole (shadows and mirrors included) with the structure s
+ * has; the processor seconds it took.  It gives up, returning what it has
+ * spent, once that exceeds `limit`. */
+#define PROBE 32
+static double probe(const Scene *s, double limit)
+{
+    Worker wk;
+    clock_t start = clock();
+    double spent = 0;
+    int i, j;
+    memset(&wk, 0, sizeof wk);
+    for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
+    for (j = 0; j < PROBE && spent <= limit; j++) {
+        for (i = 0; i < PROBE; i++)
+            trace(s, camera_ray(&s->cam, s->w, s->h, (i + (real)0.5) * s->w / PROBE,
+                                (j + (real)0.5) * s->h / PROBE), s->depth, 1, &wk);
+        spent = (double)(clock() - start) / CLOCKS_PER_SEC;
+    }
+    return spent;
+}
+
+/* One structure built into s (ACCEL_KD, ACCEL_BVH or ACCEL_GRID); 0 when
+ * out of memory. */
+static int build_one(Scene *s, int which)
+{
+    s->accel = which;
+    if (which == ACCEL_BVH) return (s->bvh = bvh_build(nobj(s), &s->prims, BVH_SAH)) != NULL;
+    if (which == ACCEL_GRID) return (s->grid = grid_build(nobj(s), &s->prims)) != NULL;
+    return (s->kd = kd_build(nobj(s), &s->prims)) != NULL;
+}
+
+/* auto: each structure is built and renders the probe; the one whose build
+ * plus the probe's time scaled to every pixel of the image is least is
+ * kept, the others freed: the time to image at one sample per pixel,
+ * estimated on the scene itself rather than by a rule on its object count.
+ * The BVH goes first (quickest to build); a probe stops once it has cost
+ * more than the best so far.  The kd-tree builds 2.6 to 8 times slower than
+ * the BVH (SPD scenes and a 100k-triangle sphere), so it is tried only when
+ * 8 times the BVH's build is under a twentieth of the BVH's estimate: the
+ * trial then costs at most 5%, and the kd-tree has room to win back its
+ * build.  The probe itself costs 1/256 of a 512x512 image per structure. */
+#define KD_BUILD_RATIO 8.0
+static int choose_accel(Scene *s)
+{
+    static const int which[3] = { ACCEL_BVH, ACCEL_GRID, ACCEL_KD };
+    double best = HUGE_VAL, cost, built = 0, scale = (double)s->w * s->h / (PROBE * PROBE);
+    int k, pick = 0;
+    for (k = 0; k < 3; k++) {
+        clock_t start = clock();
+        if (which[k] == ACCEL_KD && KD_BUILD_RATIO * built > 0.05 * best) break;
+        if (!build_one(s, which[k])) return 0;
+        cost = (double)(clock() - start) / CLOCKS_PER_SEC;
+        if (k == 0) built = cost;      /* the BVH's build */
+        cost += scale * probe(s, (best - cost) / scale);
+        if (cost < best) best = cost, pick = k;
+    }
+    for (k = 0; k < 3; k++) {
+        if (k == pick) continue;
+        if (which[k] == ACCEL_KD && s->kd) kd_free(s->kd), s->kd = NULL;
+        if (which[k] == ACCEL_BVH) bvh_free(s->bvh), s->bvh = NULL;
+        if (which[k] == ACCEL_GRID) grid_free(s->grid), s->grid = NULL;
+    }
+    s->accel = which[pick];
+    return 1;
+}
+
+/* The structure that answers nearest_hit and any_hit, as --accel says: the
+ * kd-tree, the BVH (its SAH build), the grid, none (every ray tests every
+ * object), or auto: none below TREE_FROM objects, else the one that
+ * choose_accel measures fastest on this scene. */
+static int build_accel(Scene *s, const char *accel)
+{
+    int ok;
+    s->prims.bounds = prim_bounds;
+    s->prims.clip = prim_clip;
+    s->prims.hit = prim_hit;
+    s->prims.user = s;
+    s->prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
+    s->accel = ACCEL_NONE;
+    if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
+    if (!float_range(s)) {
+        fprintf(stderr, "ray: warning: coordinates beyond the float range the structures keep their"
+                " boxes and planes in (above 1e37, or a scene within 1e-30 of the origin): every ray"
+                " tests every object instead\n");
+        return 1;
+    }
+    if (!strcmp(accel, "auto")) ok = choose_accel(s);
+    else ok = build_one(s, !strcmp(accel, "bvh") ? ACCEL_BVH : !strcmp(accel, "grid") ? ACCEL_GRID : ACCEL_KD);
+    if (!ok) fprintf(stderr, "ray: out of memory for the acceleration structure\n");
+    return ok;
+}
+
 /* ------------------------------------------------- the primitives: spheres */
+
+static void add_sphere(Scene *s, vec cen, real rad, int mat)
+{
+    Sphere *p;
+    s->sph = grow(s->sph, &s->capsph, s->nsph + 1, sizeof *s->sph);
+    p = &s->sph[s->nsph++];
+    p->cen = cen;
+    p->rad = rad;
+    p->mat = mat;
+    if (s->mat[mat].kl > 0) add_light(s, cen, s->mat[mat].color, s->nsph - 1);
+}
 
 /* A ray whose origin is farther than FAR_MOVE times a primitive's size
  * from it is first moved along itself to near the primitive, by
@@ -1556,6 +1754,35 @@ static real sphere_pdf(const Sphere *sp, vec x, vec y)
 
 /* --------------------------------------------------- the primitives: cones */
 
+static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
+{
+    Cone *c;
+    s->cone = grow(s->cone, &s->capcone, s->ncone + 1, sizeof *s->cone);
+    c = &s->cone[s->ncone++];
+    c->base = base;
+    c->len = sqrt(dot(sub(apex, base), sub(apex, base)));
+    c->axis = unit(sub(apex, base));
+    c->rb = rb;
+    c->ra = ra;
+    c->mat = mat;
+}
+
+/* A cone from base (radius rb) to apex (radius ra). */
+static int check_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why)
+{
+    if (!(rb >= 0 && ra >= 0 && rb + ra > 0))
+        return sprintf(why, "cone radii must be >= 0 and not both 0"), 0;
+    if (!(dot(sub(apex, base), sub(apex, base)) > 0))
+        return sprintf(why, "cone base and apex coincide"), 0;
+    /* Shorter than this, the rounding of a point's height along the axis
+     * exceeds the length itself, and the side would be found where it is
+     * not (the fuzz targets found one 1e-71 long, hit at the eye). */
+    if (!(sqrt(dot(sub(apex, base), sub(apex, base))) >= 1e-9 * (fmax(rb, ra) + maxabs(base) + maxabs(apex))))
+        return sprintf(why, "cone shorter than 1e-9 of its radius and coordinates"), 0;
+    add_cone(s, base, rb, apex, ra, mat);
+    return 1;
+}
+
 /* Smallest t > tmin where the ray meets the open cone's side, or INFINITY.
  * A point at height h = (p - base).axis lies on the side when its distance
  * from the axis is the radius there, rb + k h, with k the slope (ra - rb)/len,
@@ -1643,6 +1870,37 @@ static void cone_box(const Cone *c, double lo[3], double hi[3])
 }
 
 /* ----------------------------------------------- the primitives: triangles */
+
+static int add_vertex(Scene *s, vec p)
+{
+    s->vert = grow(s->vert, &s->capvert, s->nvert + 1, sizeof *s->vert);
+    s->vert[s->nvert] = p;
+    return s->nvert++;
+}
+
+static int add_normal(Scene *s, vec n)
+{
+    s->norm = grow(s->norm, &s->capnorm, s->nnorm + 1, sizeof *s->norm);
+    s->norm[s->nnorm] = n;
+    return s->nnorm++;
+}
+
+/* Vertices a, b, c and normals na, nb, nc (-1: none) by index. */
+static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, int mat)
+{
+    Triangle *tr;
+    s->tri = grow(s->tri, &s->captri, s->ntri + 1, sizeof *s->tri);
+    tr = &s->tri[s->ntri++];
+    tr->v[0] = a; tr->v[1] = b; tr->v[2] = c;
+    tr->v0 = s->vert[a];
+    tr->e1 = sub(s->vert[b], s->vert[a]);
+    tr->e2 = sub(s->vert[c], s->vert[a]);
+    if (na < 0 || nb < 0 || nc < 0) na = nb = nc = -1;
+    tr->n[0] = na; tr->n[1] = nb; tr->n[2] = nc;
+    tr->mat = mat;
+    tr->cull = (char)s->cull;
+    tr->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
+}
 
 /* a*d - b*c to within 2 ulps of its value (Kahan's algorithm with a fused
  * multiply-add; Jeannerod, Louvet and Muller, Math. Comp. 82, 2013), so its
@@ -2116,92 +2374,13 @@ static int add_material(Scene *s, Material m)
     return s->nmat++;
 }
 
-static void add_sphere(Scene *s, vec cen, real rad, int mat)
-{
-    Sphere *p;
-    s->sph = grow(s->sph, &s->capsph, s->nsph + 1, sizeof *s->sph);
-    p = &s->sph[s->nsph++];
-    p->cen = cen;
-    p->rad = rad;
-    p->mat = mat;
-    if (s->mat[mat].kl > 0) add_light(s, cen, s->mat[mat].color, s->nsph - 1);
-}
-
-static int add_vertex(Scene *s, vec p)
-{
-    s->vert = grow(s->vert, &s->capvert, s->nvert + 1, sizeof *s->vert);
-    s->vert[s->nvert] = p;
-    return s->nvert++;
-}
-
-static int add_normal(Scene *s, vec n)
-{
-    s->norm = grow(s->norm, &s->capnorm, s->nnorm + 1, sizeof *s->norm);
-    s->norm[s->nnorm] = n;
-    return s->nnorm++;
-}
-
-/* Vertices a, b, c and normals na, nb, nc (-1: none) by index. */
-static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, int mat)
-{
-    Triangle *tr;
-    s->tri = grow(s->tri, &s->captri, s->ntri + 1, sizeof *s->tri);
-    tr = &s->tri[s->ntri++];
-    tr->v[0] = a; tr->v[1] = b; tr->v[2] = c;
-    tr->v0 = s->vert[a];
-    tr->e1 = sub(s->vert[b], s->vert[a]);
-    tr->e2 = sub(s->vert[c], s->vert[a]);
-    if (na < 0 || nb < 0 || nc < 0) na = nb = nc = -1;
-    tr->n[0] = na; tr->n[1] = nb; tr->n[2] = nc;
-    tr->mat = mat;
-    tr->cull = (char)s->cull;
-    tr->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
-}
-
-
-static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
-{
-    Cone *c;
-    s->cone = grow(s->cone, &s->capcone, s->ncone + 1, sizeof *s->cone);
-    c = &s->cone[s->ncone++];
-    c->base = base;
-    c->len = sqrt(dot(sub(apex, base), sub(apex, base)));
-    c->axis = unit(sub(apex, base));
-    c->rb = rb;
-    c->ra = ra;
-    c->mat = mat;
-}
 
 
 
-/* The largest |coordinate| of a light or the camera: two points within it
- * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
- * takes between them (to a light, from the eye) stay finite; beyond it, a
- * light would light nothing and an eye see nothing.  3.9e153 in doubles. */
-#define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
 
-static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
 
-/* a times the power of two that brings its largest coordinate into
- * [1/2, 1): the same direction, and exactly the same unit() and cross()
- * bits as a itself, yet no square of it overflows or underflows. */
-static vec pow2_scaled(vec a)
-{
-    int e;
-    real m = maxabs(a);
-    if (!(m > 0) || !isfinite(m)) return a;
-    frexp(m, &e);
-    return v3((real)ldexp(a.x, -e), (real)ldexp(a.y, -e), (real)ldexp(a.z, -e));
-}
 
-/* The narrowest field of view, in degrees, for which the image plane of
- * camera_ray stays near enough to square its distance at 32768 pixels
- * across: 2.8e-148 degrees in doubles. */
-static double narrowest_fov(void)
-{
-    return 2 * atan(16384 / (sqrt(sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 2))
-           * 180 / PI;
-}
+
 
 /* A point light, within FAR_LIMIT. */
 static int point_light(Scene *s, vec pos, vec color, char *why)
@@ -2215,51 +2394,7 @@ static int point_light(Scene *s, vec pos, vec color, char *why)
     return 1;
 }
 
-/* The camera at eye v[0..2] looking at v[3..5], up towards v[6..8], with a
- * horizontal field of view of v[9] degrees. */
-static int set_camera(Scene *s, const real *v, char *why)
-{
-    Camera *c = &s->cam;
-    vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
-    c->eye = v3(v[0], v[1], v[2]);
-    if (!within_far_limit(c->eye) || !within_far_limit(at)) {
-        sprintf(why, "camera too far out: beyond %.2g, squared distances from the eye overflow",
-                (double)FAR_LIMIT);
-        return 0;
-    }
-    if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
-        return sprintf(why, "camera looks at its own eye"), 0;
-    if (!(v[9] > 0 && v[9] < 180))
-        return sprintf(why, "field of view must be between 0 and 180 degrees"), 0;
-    if (!(v[9] >= narrowest_fov())) {
-        sprintf(why, "field of view too narrow: under %.2g degrees the image plane is so far away"
-                " that its squared distance overflows", narrowest_fov());
-        return 0;
-    }
-    c->tan_half = tan(v[9] * PI / 360);
-    c->fwd = unit(pow2_scaled(sub(at, c->eye)));
-    c->right = cross(c->fwd, up);
-    if (!(dot(c->right, c->right) > 0)) return sprintf(why, "camera up is parallel to its view"), 0;
-    c->right = unit(c->right);
-    c->up = cross(c->right, c->fwd);
-    return 1;
-}
 
-/* A cone from base (radius rb) to apex (radius ra). */
-static int check_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why)
-{
-    if (!(rb >= 0 && ra >= 0 && rb + ra > 0))
-        return sprintf(why, "cone radii must be >= 0 and not both 0"), 0;
-    if (!(dot(sub(apex, base), sub(apex, base)) > 0))
-        return sprintf(why, "cone base and apex coincide"), 0;
-    /* Shorter than this, the rounding of a point's height along the axis
-     * exceeds the length itself, and the side would be found where it is
-     * not (the fuzz targets found one 1e-71 long, hit at the eye). */
-    if (!(sqrt(dot(sub(apex, base), sub(apex, base))) >= 1e-9 * (fmax(rb, ra) + maxabs(base) + maxabs(apex))))
-        return sprintf(why, "cone shorter than 1e-9 of its radius and coordinates"), 0;
-    add_cone(s, base, rb, apex, ra, mat);
-    return 1;
-}
 
 /* The builder's calls (scene.h): what scene.c read, into the Scene. */
 static vec vec_of(const double *p) { return v3((real)p[0], (real)p[1], (real)p[2]); }
@@ -2376,120 +2511,6 @@ static int load_scene(Scene *s, const char *file)
 }
 
 
-/* From this many objects on, the tree pays; below, a loop over them all
- * costs less than walking even a small tree.  Measured on scenes of random
- * spheres, 800x800 at 8 samples, one thread: 5 spheres, the loop 12% faster;
- * 8, even; 12 and 16, the tree 16% and 17% faster.  On the minray scene
- * (5 spheres) the loop is 25% faster. */
-#define TREE_FROM 8
-
-/* Whether every object lies within the range the structures' float boxes
- * and planes can hold (they clamp beyond FLT_MAX), with float precision to
- * spare: coordinates below 1e37, and a scene that reaches beyond 1e-30
- * of the origin (nearer, floats lose their bits to denormals). */
-static int float_range(const Scene *s)
-{
-    double lo[3], hi[3], big = 0;
-    int i, a;
-    for (i = 0; i < nobj(s); i++) {
-        prim_bounds((void *)s, i, lo, hi);
-        for (a = 0; a < 3; a++) big = fmax(big, fmax(fabs(lo[a]), fabs(hi[a])));
-    }
-    return nobj(s) == 0 || (big < 1e37 && big > 1e-30);
-}
-
-/* auto's probe: PROBE x PROBE pixels spread over the image, one sample
- * each, rendered whole (shadows and mirrors included) with the structure s
- * has; the processor seconds it took.  It gives up, returning what it has
- * spent, once that exceeds `limit`. */
-#define PROBE 32
-static double probe(const Scene *s, double limit)
-{
-    Worker wk;
-    clock_t start = clock();
-    double spent = 0;
-    int i, j;
-    memset(&wk, 0, sizeof wk);
-    for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
-    for (j = 0; j < PROBE && spent <= limit; j++) {
-        for (i = 0; i < PROBE; i++)
-            trace(s, camera_ray(&s->cam, s->w, s->h, (i + (real)0.5) * s->w / PROBE,
-                                (j + (real)0.5) * s->h / PROBE), s->depth, 1, &wk);
-        spent = (double)(clock() - start) / CLOCKS_PER_SEC;
-    }
-    return spent;
-}
-
-/* One structure built into s (ACCEL_KD, ACCEL_BVH or ACCEL_GRID); 0 when
- * out of memory. */
-static int build_one(Scene *s, int which)
-{
-    s->accel = which;
-    if (which == ACCEL_BVH) return (s->bvh = bvh_build(nobj(s), &s->prims, BVH_SAH)) != NULL;
-    if (which == ACCEL_GRID) return (s->grid = grid_build(nobj(s), &s->prims)) != NULL;
-    return (s->kd = kd_build(nobj(s), &s->prims)) != NULL;
-}
-
-/* auto: each structure is built and renders the probe; the one whose build
- * plus the probe's time scaled to every pixel of the image is least is
- * kept, the others freed: the time to image at one sample per pixel,
- * estimated on the scene itself rather than by a rule on its object count.
- * The BVH goes first (quickest to build); a probe stops once it has cost
- * more than the best so far.  The kd-tree builds 2.6 to 8 times slower than
- * the BVH (SPD scenes and a 100k-triangle sphere), so it is tried only when
- * 8 times the BVH's build is under a twentieth of the BVH's estimate: the
- * trial then costs at most 5%, and the kd-tree has room to win back its
- * build.  The probe itself costs 1/256 of a 512x512 image per structure. */
-#define KD_BUILD_RATIO 8.0
-static int choose_accel(Scene *s)
-{
-    static const int which[3] = { ACCEL_BVH, ACCEL_GRID, ACCEL_KD };
-    double best = HUGE_VAL, cost, built = 0, scale = (double)s->w * s->h / (PROBE * PROBE);
-    int k, pick = 0;
-    for (k = 0; k < 3; k++) {
-        clock_t start = clock();
-        if (which[k] == ACCEL_KD && KD_BUILD_RATIO * built > 0.05 * best) break;
-        if (!build_one(s, which[k])) return 0;
-        cost = (double)(clock() - start) / CLOCKS_PER_SEC;
-        if (k == 0) built = cost;      /* the BVH's build */
-        cost += scale * probe(s, (best - cost) / scale);
-        if (cost < best) best = cost, pick = k;
-    }
-    for (k = 0; k < 3; k++) {
-        if (k == pick) continue;
-        if (which[k] == ACCEL_KD && s->kd) kd_free(s->kd), s->kd = NULL;
-        if (which[k] == ACCEL_BVH) bvh_free(s->bvh), s->bvh = NULL;
-        if (which[k] == ACCEL_GRID) grid_free(s->grid), s->grid = NULL;
-    }
-    s->accel = which[pick];
-    return 1;
-}
-
-/* The structure that answers nearest_hit and any_hit, as --accel says: the
- * kd-tree, the BVH (its SAH build), the grid, none (every ray tests every
- * object), or auto: none below TREE_FROM objects, else the one that
- * choose_accel measures fastest on this scene. */
-static int build_accel(Scene *s, const char *accel)
-{
-    int ok;
-    s->prims.bounds = prim_bounds;
-    s->prims.clip = prim_clip;
-    s->prims.hit = prim_hit;
-    s->prims.user = s;
-    s->prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
-    s->accel = ACCEL_NONE;
-    if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
-    if (!float_range(s)) {
-        fprintf(stderr, "ray: warning: coordinates beyond the float range the structures keep their"
-                " boxes and planes in (above 1e37, or a scene within 1e-30 of the origin): every ray"
-                " tests every object instead\n");
-        return 1;
-    }
-    if (!strcmp(accel, "auto")) ok = choose_accel(s);
-    else ok = build_one(s, !strcmp(accel, "bvh") ? ACCEL_BVH : !strcmp(accel, "grid") ? ACCEL_GRID : ACCEL_KD);
-    if (!ok) fprintf(stderr, "ray: out of memory for the acceleration structure\n");
-    return ok;
-}
 
 /* Objects that glow (kl > 0): the path tracer's area lights, and for
  * Whitted's the spheres that are lights. */
