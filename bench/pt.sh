@@ -63,6 +63,9 @@ cpu() {
   cpu=$(awk -v t="$t" 'BEGIN { split(t, a, " "); printf "%.3f", a[1] + a[2] }')
 }
 
+# kv LOG KEY: KEY's value in a log of ./ray --stats=kv (as bench/run.sh).
+kv() { awk -v k="$2" '$1 == k { print $2; exit }' "$1"; }
+
 # spread V...: "least median greatest" of the values; range FORMAT V...:
 # "least-greatest"; ratios "A..." "B...": the pairs' ratios (as bench/run.sh).
 spread() {
@@ -210,8 +213,8 @@ fi
 # taking turns in 5 rounds ($ROUNDS if more: these runs are short, about a
 # second, and short runs spread widely on a busy machine).
 mr1() {  # mr1 ARGS...: Mrays per CPU second of one run, to $mr
-  cpu "$RAY" -t 1 --stats -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
-  mr=$(awk -v r="$(sed -n 's/^rays *\([0-9]*\):.*/\1/p' "$OUT/pt.err" | head -n 1)" -v c="$cpu" 'BEGIN { printf "%.4f", r / c / 1e6 }')
+  cpu "$RAY" -t 1 --stats=kv -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
+  mr=$(awk -v r="$(kv "$OUT/pt.err" rays)" -v c="$cpu" 'BEGIN { printf "%.4f", r / c / 1e6 }')
 }
 mr_w='' mr_p='' mr_b='' mr_rounds=$((ROUNDS > 5 ? ROUNDS : 5))
 for ((round = 1; round <= mr_rounds; round++)); do
