@@ -166,25 +166,19 @@ run_cpu() {
   cpu=$(awk -v u="$u" -v s="$s" 'BEGIN { printf "%.3f", u + s }')
 }
 
+# The tables' arithmetic is bench/table.c's (built below, into $OUT/table):
 # spread V...: "least median greatest" of the values (the median of an even
-# count: the mean of the two in the middle).
-spread() {
-  printf '%s\n' "$@" | sort -g |
-    awk '{ v[NR] = $1 } END { if (!NR) exit 1; m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-                              print v[1], m, v[NR] }'
-}
+# count: the mean of the two in the middle); median V...; range FORMAT V...:
+# "least-greatest", each in FORMAT (printf's); ratios "A1 A2 ..." "B1 B2
+# ...": A1/B1 A2/B2 ..., the pairs' ratios (as many as there are pairs).
+spread() { "$OUT/table" spread "$@"; }
+median() { "$OUT/table" median "$@"; }
+range() { "$OUT/table" range "$@"; }
+ratios() { "$OUT/table" ratios "$@"; }
 # kv LOG KEY: KEY's value in a log of ./ray --stats=kv ("key value" lines),
 # e.g. cpu_s, the render's CPU seconds (every thread; the scene's reading
 # and the structure's build are not in it), or rays, every ray of any kind.
 kv() { awk -v k="$2" '$1 == k { print $2; exit }' "$1"; }
-# median V...
-median() { spread "$@" | awk '{ print $2 }'; }
-# range FORMAT V...: "least-greatest", each in FORMAT (printf's)
-range() { local f=$1; shift; spread "$@" | awk -v f="$f" '{ printf f "-" f, $1, $3 }'; }
-# ratios "A1 A2 ..." "B1 B2 ...": A1/B1 A2/B2 ..., the pairs' ratios (as
-# many as there are pairs)
-ratios() { awk -v a="$1" -v b="$2" 'BEGIN { n = split(a, x, " "); m = split(b, y, " "); if (m < n) n = m
-                                            for (i = 1; i <= n; i++) if (y[i] + 0 > 0) printf "%.6g ", x[i] / y[i] }'; }
 
 for n in $SPPS $REF_SPP; do
   case $n in ''|*[!0-9]*|0) die "sample counts must be whole numbers from 1, not '$n'";; esac
@@ -235,6 +229,7 @@ build "$OUT/ray_float" $OMP -DREAL=float "${RAYSRC[@]}"
 build "$OUT/ppmdiff" tools/ppmdiff.c
 build "$OUT/sphereflake" bench/sphereflake.c
 build "$OUT/svgplot" bench/svgplot.c
+build "$OUT/table" bench/table.c
 # raybench includes ray.c whole and calls its internals, which change as
 # ray.c does: when it no longer builds, its sections say so and the bench
 # goes on (and fails at the end) rather than losing the other tables.
@@ -785,41 +780,11 @@ if part rays; then
 fi
 
 # ------------------------------------------- every structure, same rays
-# accel_rows LOG SCENE: the table's rows from raybench accel's result lines,
-# of one run or of several (rounds against Embree): the best of the runs'
-# best rounds, the median of their medians, the worst of their worst; the
-# build, the median of the runs' (each the best of 3 builds).
-accel_rows() {
-  awk -v scene="$2" '
-    function med(arr, key, n,   i, j, t, x) {
-      for (i = 1; i <= n; i++) x[i] = arr[key SUBSEP i]
-      for (i = 2; i <= n; i++) for (j = i; j > 1 && x[j - 1] > x[j]; j--) { t = x[j]; x[j] = x[j - 1]; x[j - 1] = t }
-      return n % 2 ? x[(n + 1) / 2] : (x[n / 2] + x[n / 2 + 1]) / 2 }
-    $1 == "result" && $3 ~ /^accel=/ {
-      delete v
-      for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
-      a = v["accel"]; k = a SUBSEP v["set"]
-      if (!(a in seen)) { seen[a] = 1; bytes[a] = v["bytes"]; names[++m] = a }
-      if (v["set"] == "primary") { nb[a]++; bl[a SUBSEP nb[a]] = v["build_s"] + 0 }
-      nr[k]++; md[k SUBSEP nr[k]] = v["median"] + 0
-      if (!(k in best) || v["best"] + 0 > best[k]) best[k] = v["best"] + 0
-      if (!(k in worst) || v["worst"] + 0 < worst[k]) worst[k] = v["worst"] + 0
-      work[k] = sprintf("%5.1f %5.1f", v["steps"], v["tests"])
-      if (v["differ"] > 0) bad[a] = bad[a] " " v["set"] ":" v["differ"] }
-    END {
-      for (q = 1; q <= m; q++) { a = names[q]
-        printf "%-11s %-10s %8.4f %7.2f ", scene, a, med(bl, a, nb[a]), bytes[a] / 1e6
-        for (s = 0; s < 2; s++) { k = a SUBSEP (s ? "random" : "primary")
-          printf " %6.2f %6.2f %6.2f ", best[k], med(md, k, nr[k]), worst[k] }
-        printf " %s  %s  %s\n", work[a SUBSEP "primary"], work[a SUBSEP "random"], (a in bad) ? "DIFFER" bad[a] : "same" } }' "$1"
-}
-
-# best_median LOG SET: the greatest median Mrays/s of raybench accel's
-# structures on SET, brute force and the recursive forms aside.
-best_median() {
-  awk -v set="$2" '$1 == "result" && $2 == "set=" set && $3 !~ /none|rec/ {
-    for (i = 4; i <= NF; i++) if ($i ~ /^median=/ && substr($i, 8) + 0 > m) m = substr($i, 8) + 0 } END { print m }' "$1"
-}
+# The accel section's rows come from bench/table.c ("table accel LOG
+# SCENE": the best of the runs' best rounds, the median of their medians,
+# the worst of their worst; the build, the median of the runs'), and each
+# round's best structure from "table best LOG SET" (the greatest median
+# Mrays/s on SET, brute force and the recursive forms aside).
 
 if part accel; then
   t_part=$SECONDS
@@ -854,7 +819,7 @@ if part accel; then
       say "accel: $name"
       log=$OUT/accel-$name.log
       if "$RAYBENCH" accel "$scene" "$ACCEL_RES" "$ACCEL_RES" "$ACCEL_N" >"$log" 2>&1; then
-        accel_rows "$log" "$name" | tee -a "$OUT/bench.txt"
+        "$OUT/table" accel "$log" "$name" | tee -a "$OUT/bench.txt"
       else
         printf '%-11s raybench failed, see %s\n' "$name" "$log" | tee -a "$OUT/bench.txt"
         status=1
@@ -891,14 +856,14 @@ if part accel; then
         cat "$rlog" >>"$log"
         # this round's best structure (none and the recursive forms aside),
         # by its median, and its BVH's build
-        ours_p+="$(best_median "$rlog" primary) " ours_r+="$(best_median "$rlog" random) "
+        ours_p+="$("$OUT/table" best "$rlog" primary) " ours_r+="$("$OUT/table" best "$rlog" random) "
         sah_b+="$(awk '$1 == "result" && $3 == "accel=bvh-sah" { for (i = 4; i <= NF; i++) if ($i ~ /^build_s=/) { print substr($i, 9); exit } }' "$rlog") "
       done
       if [ "$rc" != 0 ]; then
         printf '%-11s raybench failed, see %s\n' "$mname" "$log" | tee -a "$OUT/bench.txt"
         status=1
       else
-        accel_rows "$log" "$mname" | tee -a "$OUT/bench.txt"
+        "$OUT/table" accel "$log" "$mname" | tee -a "$OUT/bench.txt"
         if [ -n "$emb_p" ]; then
           # shellcheck disable=SC2086
           printf '%-11s %-10s %8.4f %7s  %6.2f %6.2f %6s   %6.2f %6.2f %6s   (build: %s, the median of %d runs, %s; trace: the best and the median of %d runs of 5)\n' \
@@ -967,15 +932,10 @@ if part far; then
     log=$OUT/far-sphere100k.log
     if "$RAYBENCH" far "$mesh_obj" "$FAR_RES" "$FAR_RES" "$FAR_N" >"$log" 2>&1; then
       grep -v '^result ' "$log" | tee -a "$OUT/bench.txt"
-      # per structure, the lowest median ratio of any place and ray set
-      worst=$(awk '$1 == "result" && $2 != "far=origin" {
-                     for (i = 2; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
-                     if (!(v["accel"] in w) || v["ratio"] + 0 < w[v["accel"]]) w[v["accel"]] = v["ratio"] + 0
-                     if (v["differ"] + 0) bad = 1 }
-                   END { for (a in w) printf "%s %.2f\n", a, w[a]; if (bad) print "DIFFER 0" }' "$log" | sort)
-      low=$(awk '$1 != "DIFFER" { print $2 }' <<<"$worst" | sort -g | head -n 1)
-      line=$(awk '$1 != "DIFFER" { printf "%s%s %s", n++ ? ", " : "", $1, $2 }' <<<"$worst")
-      grep -q DIFFER <<<"$worst" && { line="$line; answers DIFFER from the loop"; status=1; }
+      # per structure, the lowest median ratio of any place and ray set:
+      # the lowest of them, then "accel ratio, ...", then DIFFER or nothing
+      { read -r low; read -r line; read -r differ; } < <("$OUT/table" far "$log")
+      [ -n "$differ" ] && { line="$line; answers DIFFER from the loop"; status=1; }
       targets+=("far from the origin, sphere100k, one thread, CPU time: each structure's lowest ratio of its median Mrays/s (scene at 1e4, 1e6, 1e8; camera at 1e10, 1e13; primary and random rays) to its median at the origin: $line (target >= 0.8): $(verdict "${low:-0} >= 0.8")")
     else
       echo "sphere100k: raybench far failed, see $log" | tee -a "$OUT/bench.txt"
