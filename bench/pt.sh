@@ -53,6 +53,8 @@ $CC $CFLAGS $OMP -o "$OUT/ray_pt" ray.c scene.c image.c cli.c kdtree.c bvh.c gri
 $CC $CFLAGS -o "$OUT/pfmerr" bench/pfmerr.c -lm || die "cannot build pfmerr"
 # shellcheck disable=SC2086
 $CC $CFLAGS -o "$OUT/svgplot" bench/svgplot.c -lm || die "cannot build svgplot"
+# shellcheck disable=SC2086
+$CC $CFLAGS -o "$OUT/table" bench/table.c -lm || die "cannot build table"
 RAY=$OUT/ray_pt
 
 # cpu CMD...: runs CMD; its CPU seconds (user + system) go to $cpu.
@@ -63,17 +65,16 @@ cpu() {
   cpu=$(awk -v t="$t" 'BEGIN { split(t, a, " "); printf "%.3f", a[1] + a[2] }')
 }
 
+# kv LOG KEY: KEY's value in a log of ./ray --stats=kv (as bench/run.sh).
+kv() { awk -v k="$2" '$1 == k { print $2; exit }' "$1"; }
+
 # spread V...: "least median greatest" of the values; range FORMAT V...:
-# "least-greatest"; ratios "A..." "B...": the pairs' ratios (as bench/run.sh).
-spread() {
-  printf '%s\n' "$@" | sort -g |
-    awk '{ v[NR] = $1 } END { if (!NR) exit 1; m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
-                              print v[1], m, v[NR] }'
-}
-median() { spread "$@" | awk '{ print $2 }'; }
-range() { local f=$1; shift; spread "$@" | awk -v f="$f" '{ printf f "-" f, $1, $3 }'; }
-ratios() { awk -v a="$1" -v b="$2" 'BEGIN { n = split(a, x, " "); m = split(b, y, " "); if (m < n) n = m
-                                            for (i = 1; i <= n; i++) if (y[i] + 0 > 0) printf "%.6g ", x[i] / y[i] }'; }
+# "least-greatest"; ratios "A..." "B...": the pairs' ratios (bench/table.c,
+# as bench/run.sh).
+spread() { "$OUT/table" spread "$@"; }
+median() { "$OUT/table" median "$@"; }
+range() { "$OUT/table" range "$@"; }
+ratios() { "$OUT/table" ratios "$@"; }
 
 # reference NAME SIZE: MIS at $REF_SPP spp, seed 99 (the runs use seed 0:
 # a reference sharing their random numbers would share their noise).
@@ -133,9 +134,7 @@ done
 
 # The slope of log RMSE against log CPU time, least squares, per scene and
 # estimator (runs under 0.05 s left out: their time is mostly start-up).
-slopes=$(awk -F'\t' '$5 >= 0.05 { k = $1 "/" $3; x = log($5); y = log($6);
-    n[k]++; sx[k] += x; sy[k] += y; sxx[k] += x * x; sxy[k] += x * y }
-  END { for (k in n) if (n[k] > 1) printf "%s %.2f\n", k, (n[k] * sxy[k] - sx[k] * sy[k]) / (n[k] * sxx[k] - sx[k] * sx[k]) }' "$OUT/pt.tsv" | sort)
+slopes=$(awk -F'\t' '$5 >= 0.05 { print $1 "/" $3, $5, $6 }' "$OUT/pt.tsv" | "$OUT/table" fit)
 { echo; echo "slope of log RMSE against log time (unbiased noise: -0.5):"; printf '%s\n' "$slopes" | sed 's/^/  /'; echo; } |
   tee -a "$OUT/pt.txt"
 
@@ -210,8 +209,8 @@ fi
 # taking turns in 5 rounds ($ROUNDS if more: these runs are short, about a
 # second, and short runs spread widely on a busy machine).
 mr1() {  # mr1 ARGS...: Mrays per CPU second of one run, to $mr
-  cpu "$RAY" -t 1 --stats -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
-  mr=$(awk -v r="$(sed -n 's/^rays *\([0-9]*\):.*/\1/p' "$OUT/pt.err" | head -n 1)" -v c="$cpu" 'BEGIN { printf "%.4f", r / c / 1e6 }')
+  cpu "$RAY" -t 1 --stats=kv -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
+  mr=$(awk -v r="$(kv "$OUT/pt.err" rays)" -v c="$cpu" 'BEGIN { printf "%.4f", r / c / 1e6 }')
 }
 mr_w='' mr_p='' mr_b='' mr_rounds=$((ROUNDS > 5 ? ROUNDS : 5))
 for ((round = 1; round <= mr_rounds; round++)); do
