@@ -43,7 +43,7 @@
  *
  *     RayTrace(R):                          trace()
  *         find the nearest hit              nearest_hit()
- *           (t, point, object, normal)        surface()
+ *           (t, point, object, normal)        fill_hit()
  *         colour = black (or background)
  *         if there is a hit                 shade()
  *             for each light                   shadow_ray()
@@ -78,7 +78,7 @@
  *       kind()            sphere, cone or triangle
  *       hit_object()      its intersection test
  *       hit_sphere()      (or hit_cone(), hit_triangle())           the primitives
- *     ^ surface()         point, normals, material of the hit       finding hits
+ *     ^ fill_hit()        point, normals, material of the hit       finding hits
  *       sphere_surface()  (or cone_surface(), triangle_surface())   the primitives
  *     ^ shade()           the light at the hit                      RayTrace(R)
  *       reflect()         the mirror direction (for the highlight)
@@ -249,7 +249,7 @@ typedef struct {
     int obj, mat;
     vec p;        /* the point */
     vec n, ng;    /* shading and geometric normal, both outward (front) */
-    real size;    /* coordinate magnitude behind p's rounding error */
+    real error_scale;   /* the coordinates' magnitude that p's rounding error scales with */
 } Hit;
 
 /* What the acceleration structure hands its hit callback for one query:
@@ -405,7 +405,7 @@ static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk);
 static int prim_hit(void *user, int i, void *ray, double tmin, double tmax, double *t);
 static int kind(const Scene *s, int i, int *k);
 static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t);
-static void surface(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h);
+static void fill_hit(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h);
 static Ray spawn(const Scene *s, const Hit *h, vec dir);
 static int any_hit(const Scene *s, Ray r, real tmax, int *last, Worker *wk);
 static int find_any(const Scene *s, Query *q, real tmax, Worker *wk);
@@ -423,7 +423,7 @@ static int sphere_clip(const Sphere *sp, const double blo[3], const double bhi[3
 static real sphere_sample(const Sphere *sp, vec x, real u, real v, vec *wi, real *dist);
 static real sphere_pdf(const Sphere *sp, vec x, vec y);
 static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat);
-static int check_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why);
+static int add_checked_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why);
 static real hit_cone(const Cone *c, const Ray *r, real tmin);
 static void cone_surface(const Cone *c, const Ray *r, real t, Hit *h);
 static void cone_box(const Cone *c, double lo[3], double hi[3]);
@@ -1270,7 +1270,7 @@ static int nearest_hit(const Scene *s, Ray r, Hit *h, Worker *wk)
     best = find_nearest(s, &q, &t, wk);
     if (best < 0) return 0;
     wk->count.hits++;
-    surface(s, r, best, t, &q, h);
+    fill_hit(s, r, best, t, &q, h);
     return 1;
 }
 
@@ -1360,7 +1360,7 @@ static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
 
 /* The point, normals and material of the hit on object i at t.  q (or
  * NULL) may hold the barycentrics of that hit already. */
-static void surface(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h)
+static void fill_hit(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h)
 {
     int k, what = kind(s, i, &k);
     real u, v, tt;
@@ -1385,7 +1385,7 @@ static void surface(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h
  * roundings between the ray, the root and the point, with margin. */
 static Ray spawn(const Scene *s, const Hit *h, vec dir)
 {
-    real eps = 64 * REAL_EPS * h->size;
+    real eps = 64 * REAL_EPS * h->error_scale;
     int k, out = dot(dir, h->ng) >= 0, what = kind(s, h->obj, &k);
     Ray r;
     r.o = comb(out ? eps : -eps, h->ng, h->p);
@@ -1670,7 +1670,7 @@ static void sphere_surface(const Sphere *sp, const Ray *r, real t, Hit *h)
     h->p = comb(t, r->d, r->o);
     h->n = h->ng = unit(sub(h->p, sp->cen));
     h->mat = sp->mat;
-    h->size = maxabs(h->p) + maxabs(sp->cen) + sp->rad + maxabs(r->o);
+    h->error_scale = maxabs(h->p) + maxabs(sp->cen) + sp->rad + maxabs(r->o);
 }
 
 static void sphere_box(const Sphere *sp, double lo[3], double hi[3])
@@ -1768,7 +1768,7 @@ static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
 }
 
 /* A cone from base (radius rb) to apex (radius ra). */
-static int check_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why)
+static int add_checked_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why)
 {
     if (!(rb >= 0 && ra >= 0 && rb + ra > 0))
         return sprintf(why, "cone radii must be >= 0 and not both 0"), 0;
@@ -1842,7 +1842,7 @@ static void cone_surface(const Cone *c, const Ray *r, real t, Hit *h)
     h->p = comb(t, r->d, r->o);
     h->n = h->ng = cone_normal(c, h->p);
     h->mat = c->mat;
-    h->size = maxabs(h->p) + maxabs(c->base) + c->len + c->rb + c->ra + maxabs(r->o);
+    h->error_scale = maxabs(h->p) + maxabs(c->base) + c->len + c->rb + c->ra + maxabs(r->o);
 }
 
 /* The box of a disc of radius r about centre c, square to the unit vector
@@ -2032,7 +2032,7 @@ static void triangle_surface(const Scene *s, const Triangle *tr, real u, real v,
         if (dot(n, n) > 0) h->n = unit(dot(n, h->ng) < 0 ? scale(-1, n) : n);
     }
     h->mat = tr->mat;
-    h->size = maxabs(a) + maxabs(b) + maxabs(c);
+    h->error_scale = maxabs(a) + maxabs(b) + maxabs(c);
 }
 
 static void triangle_box(const Scene *s, const Triangle *tr, double lo[3], double hi[3])
@@ -2419,7 +2419,7 @@ static int build_sphere(void *user, const double c[3], double r, int mat, char *
 static int build_cone(void *user, const double base[3], double rb, const double apex[3], double ra,
                       int mat, char *why)
 {
-    return check_cone(user, vec_of(base), (real)rb, vec_of(apex), (real)ra, mat, why);
+    return add_checked_cone(user, vec_of(base), (real)rb, vec_of(apex), (real)ra, mat, why);
 }
 
 static int build_vertex(void *user, const double p[3]) { return add_vertex(user, vec_of(p)); }
