@@ -57,24 +57,29 @@ $CC $CFLAGS -o "$OUT/svgplot" bench/svgplot.c -lm || die "cannot build svgplot"
 $CC $CFLAGS -o "$OUT/table" bench/table.c -lm || die "cannot build table"
 RAY=$OUT/ray_pt
 
-# cpu CMD...: runs CMD; its CPU seconds (user + system) go to $cpu.
+# cpu CMD...: runs CMD; its CPU seconds (user + system) go to $cpu (in
+# whole milliseconds, as `time` prints them: the shell's own arithmetic).
 cpu() {
-  local TIMEFORMAT='%3U %3S' t
+  local TIMEFORMAT='%3U %3S' u s ms
   { time "$@" >/dev/null 2>"$OUT/pt.err"; } 2>"$OUT/pt.time" || { cat "$OUT/pt.err" >&2; return 1; }
-  t=$(tail -n 1 "$OUT/pt.time")
-  cpu=$(awk -v t="$t" 'BEGIN { split(t, a, " "); printf "%.3f", a[1] + a[2] }')
+  read -r u s < <(tail -n 1 "$OUT/pt.time")
+  ms=$((10#${u/./} + 10#${s/./}))
+  cpu=$(printf '%d.%03d' $((ms / 1000)) $((ms % 1000)))
 }
 
-# kv LOG KEY: KEY's value in a log of ./ray --stats=kv (as bench/run.sh).
-kv() { awk -v k="$2" '$1 == k { print $2; exit }' "$1"; }
-
-# spread V...: "least median greatest" of the values; range FORMAT V...:
-# "least-greatest"; ratios "A..." "B...": the pairs' ratios (bench/table.c,
-# as bench/run.sh).
-spread() { "$OUT/table" spread "$@"; }
-median() { "$OUT/table" median "$@"; }
-range() { "$OUT/table" range "$@"; }
-ratios() { "$OUT/table" ratios "$@"; }
+# The arithmetic and the tables are bench/table.c's, as in bench/run.sh
+# (its subcommands are listed at its top): kv LOG KEY: KEY's value in a log
+# of ./ray --stats=kv; spread V...: "least median greatest" of the values;
+# range FORMAT V...: "least-greatest"; ratios "A..." "B...": the pairs'
+# ratios; ratio FORMAT A B: one; verdict A OP B: "met" or "NOT MET".
+table() { "$OUT/table" "$@"; }
+kv() { table kv "$@"; }
+spread() { table spread "$@"; }
+median() { table median "$@"; }
+range() { table range "$@"; }
+ratios() { table ratios "$@"; }
+ratio() { table ratio "$@"; }
+verdict() { table verdict "$@"; }
 
 # reference NAME SIZE: MIS at $REF_SPP spp, seed 99 (the runs use seed 0:
 # a reference sharing their random numbers would share their noise).
@@ -93,6 +98,7 @@ reference() {
 }
 
 : >"$OUT/pt.tsv"
+t_b='' e_b='' rounds_b='' cornell_size=''
 : >"$OUT/pt-targets.txt"
 {
   echo "Path tracing: time against error, one thread (./ray -t 1 --pt); cpu s: CPU seconds (user + system) of the whole"
@@ -123,8 +129,13 @@ for item in $SCENES; do
       # shellcheck disable=SC2086
       read -r lo med hi <<<"$(spread ${times[$est]})"
       # the rounds' times, in order, last (for the ratios round by round)
+      rounds=$(printf '%s' "${times[$est]% }" | tr ' ' ,)
       printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$size" "$est" "$spp" "$med" "$rmse" "$lit" "$disp" \
-        "$lo" "$hi" "$(printf '%s' "${times[$est]% }" | tr ' ' ,)" >>"$OUT/pt.tsv"
+        "$lo" "$hi" "$rounds" >>"$OUT/pt.tsv"
+      # target 1's figures (below): the Cornell box's first BSDF run at 256 spp
+      if [ "$name/$est/$spp" = cornell/bsdf/256 ] && [ -z "$e_b" ]; then
+        t_b=$med e_b=$rmse rounds_b=$rounds cornell_size=$size
+      fi
       printf '%-8s %-8s %-5s %5s %8.3f %-15s %10.5f %10.5f %8.2f\n' "$name" "$size" "$est" "$spp" "$med" \
         "($(printf '%.3f-%.3f' "$lo" "$hi"))" "$rmse" "$lit" "$disp" | tee -a "$OUT/pt.txt"
     done
@@ -134,13 +145,12 @@ done
 
 # The slope of log RMSE against log CPU time, least squares, per scene and
 # estimator (runs under 0.05 s left out: their time is mostly start-up).
-slopes=$(awk -F'\t' '$5 >= 0.05 { print $1 "/" $3, $5, $6 }' "$OUT/pt.tsv" | "$OUT/table" fit)
+slopes=$(table pt-slopes "$OUT/pt.tsv")
 { echo; echo "slope of log RMSE against log time (unbiased noise: -0.5):"; printf '%s\n' "$slopes" | sed 's/^/  /'; echo; } |
   tee -a "$OUT/pt.txt"
 
 # The plot: one line per scene and estimator, its slope in its name.
-awk -F'\t' -v slopes="$slopes" 'BEGIN { n = split(slopes, l, "\n"); for (i = 1; i <= n; i++) { split(l[i], p, " "); s[p[1]] = p[2] } }
-  { k = $1 "/" $3; print k ",slope=" s[k], $5, $6, $4 }' "$OUT/pt.tsv" |
+table pt-plot "$OUT/pt.tsv" |
   "$OUT/svgplot" --title "make bench: path tracing, time against error (labels: samples per pixel)" \
     --xlabel "CPU seconds, one thread (median of the rounds)" --ylabel "RMSE (linear) against the $REF_SPP-spp reference" >"$OUT/pt.svg" ||
   die "svgplot failed"
@@ -148,17 +158,11 @@ awk -F'\t' -v slopes="$slopes" 'BEGIN { n = split(slopes, l, "\n"); for (i = 1; 
 # Target 1: MIS against BSDF sampling at 256 spp on the Cornell box, round
 # by round: each round's BSDF time against the time at which that round's
 # MIS runs reach the same RMSE (the RMSEs are the same each round).
-row() { awk -F'\t' -v n="$1" -v e="$2" -v s="$3" '$1 == n && $3 == e && $4 == s { print $5, $6, $11 }' "$OUT/pt.tsv"; }
-if read -r t_b e_b rounds_b <<<"$(row cornell bsdf 256)" && [ -n "${e_b:-}" ]; then
+if [ -n "$e_b" ]; then
   # mis_at ROUND: MIS's time at RMSE $e_b in that round (1, 2, ...; 0: the
   # medians), by log-log interpolation between its two bracketing runs;
   # "<T" when its cheapest run is already below; empty when never reached.
-  mis_at() {
-    awk -F'\t' -v e="$e_b" -v k="$1" '$1 == "cornell" && $3 == "mis" { split($11, c, ","); t[++n] = k ? c[k] : $5; r[n] = $6 }
-      END { for (i = 1; i < n; i++) if (r[i] >= e && r[i + 1] <= e) {
-              s = log(r[i + 1] / r[i]) / log(t[i + 1] / t[i]); printf "%.4f", t[i] * exp(log(e / r[i]) / s); exit }
-            if (n && r[1] <= e) printf "<%s", t[1]; else print "" }' "$OUT/pt.tsv"
-  }
+  mis_at() { table time-at "$OUT/pt.tsv" cornell mis "$e_b" "$1"; }
   t_m=$(mis_at 0)
   if [ -z "$t_m" ]; then
     echo "Cornell box: MIS never reached BSDF sampling's RMSE at 256 spp ($e_b): NOT MET" >>"$OUT/pt-targets.txt"
@@ -167,13 +171,13 @@ if read -r t_b e_b rounds_b <<<"$(row cornell bsdf 256)" && [ -n "${e_b:-}" ]; t
     IFS=, read -r -a tb <<<"$rounds_b"
     for ((k = 1; k <= ${#tb[@]}; k++)); do
       tm=$(mis_at "$k")
-      xs+="$(awk -v a="${tb[k - 1]}" -v b="${tm#<}" 'BEGIN { printf "%.4g", a / b }') "
+      xs+="$(ratio %.4g "${tb[k - 1]}" "${tm#<}") "
     done
     # shellcheck disable=SC2086
     x=$(printf %.1f "$(median $xs)")
-    v=$(awk "BEGIN { exit !($x >= 10) }" && echo met || echo "NOT MET")
+    v=$(verdict "$x" ">=" 10)
     # shellcheck disable=SC2086
-    echo "Cornell box $(awk -F'\t' '$1 == "cornell" { print $2; exit }' "$OUT/pt.tsv"), one thread: BSDF sampling at 256 spp: RMSE $e_b in $t_b s CPU; MIS reaches it in ${t_m} s (medians of $ROUNDS rounds taking turns): ${x}x less time ($(range %.1f $xs), the rounds' ratios) (target >= 10x): $v" >>"$OUT/pt-targets.txt"
+    echo "Cornell box $cornell_size, one thread: BSDF sampling at 256 spp: RMSE $e_b in $t_b s CPU; MIS reaches it in ${t_m} s (medians of $ROUNDS rounds taking turns): ${x}x less time ($(range %.1f $xs), the rounds' ratios) (target >= 10x): $v" >>"$OUT/pt-targets.txt"
   fi
 fi
 
@@ -189,18 +193,18 @@ if [ -n "$SMALLPT" ] && [ -f "$SMALLPT" ] && command -v g++ >/dev/null && g++ -O
   done
   samples=$((1024 * 768 * 4))
   # shellcheck disable=SC2086
-  us_o=$(awk "BEGIN { printf \"%.3f\", $(median $ours) / $samples * 1e6 }")
+  us_o=$(table us-per "$(median $ours)" "$samples" %.3f)
   # shellcheck disable=SC2086
-  us_s=$(awk "BEGIN { printf \"%.3f\", $(median $sp) / $samples * 1e6 }")
+  us_s=$(table us-per "$(median $sp)" "$samples" %.3f)
   q=$(ratios "$ours" "$sp")
   # shellcheck disable=SC2086
   qm=$(printf %.2f "$(median $q)")
-  v=$(awk "BEGIN { exit !($qm <= 1) }" && echo met || echo "NOT MET")
+  v=$(verdict "$qm" "<=" 1)
   # shellcheck disable=SC2086
   echo "smallpt's scene 1024x768 at 4 spp, one thread, medians of $ROUNDS rounds taking turns: ours (BSDF sampling) $us_o us of CPU a sample, smallpt (g++ -O3) $us_s us: ratio $qm ($(range %.2f $q), the rounds' ratios) (target <= 1): $v" >>"$OUT/pt-targets.txt"
 else
   cpu "$RAY" --pt -t 1 --estimator bsdf -s 1024x768 -n 4 -o "$OUT/pt-ours-smallpt.pfm" scenes/smallpt.sph || die "ray failed"
-  us_o=$(awk "BEGIN { printf \"%.3f\", $cpu / (1024 * 768 * 4) * 1e6 }")
+  us_o=$(table us-per "$cpu" $((1024 * 768 * 4)) %.3f)
   echo "smallpt's scene 1024x768 at 4 spp, one thread: ours (BSDF sampling) $us_o us of CPU a sample; smallpt not run (set BENCH_SMALLPT=path/to/smallpt.cpp)" >>"$OUT/pt-targets.txt"
 fi
 
@@ -210,7 +214,7 @@ fi
 # second, and short runs spread widely on a busy machine).
 mr1() {  # mr1 ARGS...: Mrays per CPU second of one run, to $mr
   cpu "$RAY" -t 1 --stats=kv -s 256x192 -n 16 -o "$OUT/pt-rays.ppm" "$@" scenes/smallpt.sph || die "ray failed"
-  mr=$(awk -v r="$(kv "$OUT/pt.err" rays)" -v c="$cpu" 'BEGIN { printf "%.4f", r / c / 1e6 }')
+  mr=$(table mrays "$(kv "$OUT/pt.err" rays)" "$cpu")
 }
 mr_w='' mr_p='' mr_b='' mr_rounds=$((ROUNDS > 5 ? ROUNDS : 5))
 for ((round = 1; round <= mr_rounds; round++)); do
@@ -221,7 +225,7 @@ done
 q=$(ratios "$mr_p" "$mr_w")
 # shellcheck disable=SC2086
 r=$(printf %.2f "$(median $q)")
-v=$(awk "BEGIN { exit !($r >= 0.9) }" && echo met || echo "NOT MET")
+v=$(verdict "$r" ">=" 0.9)
 # shellcheck disable=SC2086
 echo "smallpt's scene 256x192, one thread, medians of $mr_rounds rounds taking turns: path tracing (MIS) $(printf %.2f "$(median $mr_p)") Mrays/s ($(range %.2f $mr_p)) (BSDF sampling $(printf %.2f "$(median $mr_b)")), Whitted $(printf %.2f "$(median $mr_w)") Mrays/s ($(range %.2f $mr_w)): ratio $r ($(range %.2f $q), the rounds' ratios) (target >= 0.9): $v" >>"$OUT/pt-targets.txt"
 

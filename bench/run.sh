@@ -120,7 +120,7 @@
 #   BENCH_BALLS_NONE_RUNS=2  how many of those runs (in the first rounds)
 # CC and CFLAGS choose the compiler, as for make.
 set -u -o pipefail
-export LC_ALL=C   # a '.' decimal point from `time` and awk, whatever the locale
+export LC_ALL=C   # a '.' decimal point from `time` and printf, whatever the locale
 cd "$(dirname "$0")/.." || exit 2
 
 CC=${CC:-cc}
@@ -163,22 +163,32 @@ run_cpu() {
   shift
   { time "$@" >"$log" 2>&1; } 2>"$OUT/time.txt" || return 1
   read -r u s wall < <(tail -n 1 "$OUT/time.txt")
-  cpu=$(awk -v u="$u" -v s="$s" 'BEGIN { printf "%.3f", u + s }')
+  cpu=$(sum3 "$u" "$s")
+}
+# sum3 A B: A + B, each with 3 decimals as `time` prints them, in whole
+# milliseconds (exact, and the shell's own arithmetic).
+sum3() {
+  local ms=$((10#${1/./} + 10#${2/./}))
+  printf '%d.%03d\n' $((ms / 1000)) $((ms % 1000))
 }
 
-# The tables' arithmetic is bench/table.c's (built below, into $OUT/table):
+# The tables' arithmetic, and the reading of our own logs, is bench/table.c's
+# (built below, into $OUT/table; its subcommands are listed at its top):
 # spread V...: "least median greatest" of the values (the median of an even
 # count: the mean of the two in the middle); median V...; range FORMAT V...:
 # "least-greatest", each in FORMAT (printf's); ratios "A1 A2 ..." "B1 B2
-# ...": A1/B1 A2/B2 ..., the pairs' ratios (as many as there are pairs).
-spread() { "$OUT/table" spread "$@"; }
-median() { "$OUT/table" median "$@"; }
-range() { "$OUT/table" range "$@"; }
-ratios() { "$OUT/table" ratios "$@"; }
+# ...": A1/B1 A2/B2 ..., the pairs' ratios (as many as there are pairs);
+# ratio FORMAT A B: one.
+table() { "$OUT/table" "$@"; }
+spread() { table spread "$@"; }
+median() { table median "$@"; }
+range() { table range "$@"; }
+ratios() { table ratios "$@"; }
+ratio() { table ratio "$@"; }
 # kv LOG KEY: KEY's value in a log of ./ray --stats=kv ("key value" lines),
 # e.g. cpu_s, the render's CPU seconds (every thread; the scene's reading
 # and the structure's build are not in it), or rays, every ray of any kind.
-kv() { awk -v k="$2" '$1 == k { print $2; exit }' "$1"; }
+kv() { table kv "$@"; }
 
 for n in $SPPS $REF_SPP; do
   case $n in ''|*[!0-9]*|0) die "sample counts must be whole numbers from 1, not '$n'";; esac
@@ -300,7 +310,8 @@ error() {
   if [ -z "$rmse" ] || [ -z "$psnr" ]; then die "cannot read ppmdiff's output: $line"; fi
 }
 
-spheres() { awk '$1 ~ /^[-+.0-9]/ { n++ } END { print n + 0 }' "$1"; }
+# spheres SCENE: the scene file's lines that begin with a number.
+spheres() { grep -c '^[[:blank:]]*[-+.0-9]' "$1"; }
 
 # shellcheck disable=SC2086
 base_spp=$(printf '%s\n' $SPPS | sort -n | head -n 1)
@@ -309,10 +320,10 @@ nsum=0; for n in $SPPS; do nsum=$((nsum + n)); done
 : >"$OUT/bench.txt"
 t_start=$SECONDS
 
-# repeats SECONDS: how many turns a render of that many CPU seconds gets:
-# 5 under half a second, 3 above (a short run measures start-up and other
-# processes' disturbance as much as the renderer).
-repeats() { awk -v t="$1" 'BEGIN { print (t < 0.5) ? 5 : 3 }'; }
+# table repeats FIRST SPP SPP0: how many turns a render at SPP gets, judged
+# from the first at SPP0, FIRST seconds: 5 under half a second, 3 above (a
+# short run measures start-up and other processes' disturbance as much as
+# the renderer).
 
 # bench NAME SCENE SIZE
 bench() {
@@ -323,13 +334,14 @@ bench() {
   render "$OUT/ray_double" "$scene" "$size" "$base_spp" "$OUT/$name-double-$base_spp.ppm"
   first=$took
   say "$name ($size, $nsph spheres): double $base_spp spp: $took s CPU"
-  awk "BEGIN { e = $first / $base_spp * (6 * $nsum + $REF_SPP);
-               if (e > 240) printf \"bench: %s: expect about %.0f CPU seconds more; BENCH_* in bench/run.sh trade size for time\\n\", \"$name\", e }" >&2
+  if e=$(table more "$first" "$base_spp" "$nsum" "$REF_SPP"); then
+    say "$name: expect about $e CPU seconds more; BENCH_* in bench/run.sh trade size for time"
+  fi
   reference "$name" "$scene" "$size"
   base=
   # shellcheck disable=SC2086
   for spp in $(printf '%s\n' $SPPS | sort -n); do
-    n=$(repeats "$(awk -v b="$first" -v s="$spp" -v s0="$base_spp" 'BEGIN { print b * s / s0 }')")
+    n=$(table repeats "$first" "$spp" "$base_spp")
     turns "$n" "$name" "$scene" "$size" "$spp"
     [ -n "$base" ] || base=$(median $t_double)
     say "$name: $spp spp, $n turns: double $t_double, float $t_float (CPU s)"
@@ -339,7 +351,7 @@ bench() {
       # shellcheck disable=SC2086
       read -r lo med hi <<<"$(spread $list)"
       printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$size" "$nsph" "$b" \
-        "$spp" "$med" "$(awk "BEGIN { printf \"%.2f\", $med / $base }")" \
+        "$spp" "$med" "$(ratio %.2f "$med" "$base")" \
         "$rmse" "$psnr" "$lo" "$hi" "$n" >>"$OUT/bench.tsv"
     done
   done
@@ -362,8 +374,7 @@ if part render; then
     rt=${rt:-$took}
     FLAKE_SIZE=128x128
     for w in 512 256; do
-      est=$(awk "BEGIN { f = $took - $rt; if (f < 0) f = 0;
-                         printf \"%.0f\", $nruns * f + $rt * ($w / 128)^2 * (6 * $nsum + $REF_SPP) }")
+      est=$(table flake-cost "$took" "$rt" "$nruns" "$w" "$nsum" "$REF_SPP")
       if [ "$est" -le "$FLAKE_BUDGET" ]; then FLAKE_SIZE=${w}x$w; break; fi
       say "sphereflake: ${w}x$w would take about $est CPU seconds, over BENCH_FLAKE_BUDGET=$FLAKE_BUDGET"
     done
@@ -382,11 +393,10 @@ if part render; then
     echo "spheres: in the scene file, ground and lights included"
     echo
     printf '%-12s %-9s %7s  %-6s %4s %8s %15s %5s %7s %8s %7s\n' scene size spheres build spp "CPU s" "(least-greatest)" runs ratio RMSE PSNR
-    awk -F'\t' '{ printf "%-12s %-9s %7s  %-6s %4s %8.3f %15s %5s %7s %8s %7s\n", $1, $2, $3, $4, $5, $6,
-                   sprintf("(%.3f-%.3f)", $10, $11), $12, $7, $8, $9 }' "$OUT/bench.tsv"
+    table render "$OUT/bench.tsv"
   } | tee -a "$OUT/bench.txt"
 
-  awk -F'\t' '{ print $1 "/" $4, $6, $8, $5 }' "$OUT/bench.tsv" |
+  table render-plot "$OUT/bench.tsv" |
     "$OUT/svgplot" --title "make bench: Whitted ray tracer, time against error (labels: samples per pixel)" \
       --xlabel "CPU seconds per image (user + system, every thread; median of the runs)" \
       --ylabel "RMSE against the $REF_SPP-spp double reference" >"$OUT/bench.svg" ||
@@ -400,7 +410,8 @@ fi
 # and on whatever else runs on them.
 
 targets=()   # one line per target, printed together at the end
-verdict() { awk "BEGIN { exit !($1) }" && echo met || echo "NOT MET"; }
+# verdict A OP B: "met" when A OP B (OP: < <= > >=), else "NOT MET".
+verdict() { table verdict "$@"; }
 num() { [[ ${1:-} =~ ^[0-9]+([.][0-9]*)?([eE][-+]?[0-9]+)?$ ]]; }
 
 # install_pkg PACKAGE: only with BENCH_INSTALL=1, and never fatal: the
@@ -420,7 +431,7 @@ install_pkg() {
 # tests_per_ray: hit tests per query (of the nearest hit, or of any), as
 # --stats' "per ray" line.
 objects() { echo $(($(kv "$1" spheres) + $(kv "$1" cones) + $(kv "$1" triangles))); }
-tests_per_ray() { awk -v t="$(kv "$1" tests)" -v q="$(kv "$1" queries)" 'BEGIN { printf "%.2f", (q > 0 ? t / q : 0) }'; }
+tests_per_ray() { ratio %.2f "$(kv "$1" tests)" "$(kv "$1" queries)" || echo 0.00; }
 
 # ray1 SCENE SIZE ACCEL OUTPUT LOG [ARGS...]: one single-threaded ./ray run
 # with --stats=kv into LOG; the whole run's CPU seconds (user + system) in
@@ -438,35 +449,29 @@ ray1() {
 }
 
 # rfield LOG SET KEY: KEY's value on raybench's "result" lines (of set SET,
-# when not empty); the last one wins.
-rfield() {
-  awk -v set="$2" -v key="$3" '
-    $1 == "result" && (set == "" || $2 == "set=" set) {
-      for (i = 2; i <= NF; i++) if (index($i, key "=") == 1) v = substr($i, length(key) + 2) }
-    END { print v }' "$1"
-}
-
-# rvalues LOG SET KEY: KEY's values on LOG's result lines of set SET (every
-# set when empty), one a round, in the order of the rounds.
-rvalues() {
-  awk -v set="$2" -v key="$3" '
-    $1 == "result" && (set == "" || $2 == "set=" set) {
-      for (i = 2; i <= NF; i++) if (index($i, key "=") == 1) printf "%s ", substr($i, length(key) + 2) }' "$1"
-}
+# when not empty); the last one wins.  rvalues LOG SET KEY: KEY's values on
+# LOG's result lines of set SET (every set when empty), one a round, in the
+# order of the rounds.
+rfield() { table field "$1" "${2:+set=$2}" "$3"; }
+rvalues() { table values "$1" "${2:+set=$2}" "$3"; }
 
 # embree_field LOG KIND: embree_rays' median Mrays/s by thread CPU time on
-# KIND (primary, random) rays; "build": its build's seconds, CPU time from
-# bench/embree_cpu.c when it ran, else the wall clock (embree_rays' own).
+# KIND (primary, random) rays; KIND-best: the best round's; "build": its
+# build's seconds, CPU time from bench/embree_cpu.c when it ran, else the
+# wall clock (embree_rays' own).  The one reader of Embree's output.
 embree_field() {
-  if [ "$2" = build ]; then
-    if grep -q '^embree_cpu: rtcCommitScene' "$1"; then
-      sed -n 's/^embree_cpu: rtcCommitScene \([0-9.]*\) s CPU (process).*/\1/p' "$1" | head -n 1
-    else
-      sed -n 's/.*BUILD quality=[^:]*: \([0-9.]*\) s.*/\1/p' "$1" | head -n 1
-    fi
-  else
-    grep -A1 "TRACE $2" "$1" | sed -n 's/.*thread CPU time: best .* median \([0-9.]*\)).*/\1/p' | head -n 1
-  fi
+  case $2 in
+    build)
+      if grep -q '^embree_cpu: rtcCommitScene' "$1"; then
+        sed -n 's/^embree_cpu: rtcCommitScene \([0-9.]*\) s CPU (process).*/\1/p' "$1" | head -n 1
+      else
+        sed -n 's/.*BUILD quality=[^:]*: \([0-9.]*\) s.*/\1/p' "$1" | head -n 1
+      fi ;;
+    *-best)
+      grep -A1 "TRACE ${2%-best}" "$1" | sed -n 's/.*thread CPU time: best [0-9.]* s = \([0-9.]*\) Mrays.*/\1/p' | head -n 1 ;;
+    *)
+      grep -A1 "TRACE $2" "$1" | sed -n 's/.*thread CPU time: best .* median \([0-9.]*\)).*/\1/p' | head -n 1 ;;
+  esac
 }
 
 # ------------------------------------------------------- kd against none
@@ -500,10 +505,7 @@ if part spd; then
       continue
     fi
     t16=$rsecs
-    side=16
-    for w in 96 64 48 32 24; do
-      if awk "BEGIN { exit !($t16 * ($w / 16)^2 <= $NONE_BUDGET) }"; then side=$w; break; fi
-    done
+    side=$(table spd-side "$t16" "$NONE_BUDGET")
     size=${side}x$side
     # kd at one sample per pixel: its picture and rays, against none's, and
     # how many samples make its render long enough to time
@@ -514,19 +516,18 @@ if part spd; then
       continue
     fi
     kd_log=$OUT/spd-$name-kd.log none_log=$OUT/spd-$name-none.log
-    spp=1 kd_args=() kd_out=$OUT/spd-$name-kd.ppm
-    if awk "BEGIN { exit !($rsecs < 0.05) }"; then
-      spp=$(awk "BEGIN { k = int(0.1 / ($rsecs > 0.001 ? $rsecs : 0.001)) + 1; print (k > 64) ? 64 : k }")
+    spp=$(table kd-spp "$rsecs") kd_args=() kd_out=$OUT/spd-$name-kd.ppm
+    if [ "$spp" -gt 1 ]; then
       kd_args=(-n "$spp") kd_out=$OUT/spd-$name-kd-n.ppm kd_log=$OUT/spd-$name-kd-n.log
     fi
     say "spd: $name: none and kd at $size, $ROUNDS rounds"
     none_us='' kd_us='' setup='' ok=1
     for ((r = 1; r <= ROUNDS; r++)); do
       ray1 "$scene" "$size" none "$OUT/spd-$name-none.ppm" "$none_log" || { ok=; break; }
-      none_us+="$(awk -v s="$rsecs" -v r="$(kv "$none_log" rays)" 'BEGIN { printf "%.6g", s / r * 1e6 }') "
+      none_us+="$(table us-per "$rsecs" "$(kv "$none_log" rays)") "
       ray1 "$scene" "$size" kd "$kd_out" "$kd_log" ${kd_args[@]+"${kd_args[@]}"} || { ok=; break; }
-      kd_us+="$(awk -v s="$rsecs" -v r="$(kv "$kd_log" rays)" 'BEGIN { printf "%.6g", s / r * 1e6 }') "
-      setup+="$(awk -v a="$took" -v b="$rsecs" 'BEGIN { printf "%.4f", a - b }') "
+      kd_us+="$(table us-per "$rsecs" "$(kv "$kd_log" rays)") "
+      setup+="$(table setup "$took" "$rsecs") "
     done
     if [ -z "$ok" ]; then
       printf '%-10s ./ray failed, see %s and %s\n' "$name" "$none_log" "$kd_log" | tee -a "$OUT/bench.txt"
@@ -544,7 +545,7 @@ if part spd; then
       "$size" "$none_rays" "$(median $none_us)" "($(range %.2f $none_us))" "$(median $kd_us)" \
       "($(range %.4f $kd_us))" "$spp" "$(median $sp)" \
       "($(range %.0f $sp))" "$(tests_per_ray "$OUT/spd-$name-kd.log")" "$(median $setup)" \
-      "$(awk -v b="$(kv "$OUT/spd-$name-kd.log" accel_bytes)" -v o="$objects" 'BEGIN { print b / o }')" "$images")
+      "$(ratio %.6g "$(kv "$OUT/spd-$name-kd.log" accel_bytes)" "$objects")" "$images")
     echo "$row" | tee -a "$OUT/bench.txt"
     # shellcheck disable=SC2086
     [ "$name" = balls_s4 ] && balls_none_us="$(median $none_us) $size"
@@ -562,12 +563,12 @@ if part build; then
     say "build: every structure over 10k to $BUILD_MAX triangles, taking turns"
     if "$RAYBENCH" build "$BUILD_MAX" >"$OUT/build.log" 2>&1; then
       grep -v '^result ' "$OUT/build.log" | tee -a "$OUT/bench.txt"
-      # the kd-tree's lines: "result exponent=..." and "result triangles=..."
-      kdf() { awk -v k="$1" -v first="$2" '$1 == "result" && index($2, first "=") == 1 {
-                for (i = 2; i <= NF; i++) if (index($i, k "=") == 1) v = substr($i, length(k) + 2) } END { print v }' "$OUT/build.log"; }
+      # kdf KEY FIRST: KEY on the kd-tree's lines, "result exponent=..." and
+      # "result triangles=..."
+      kdf() { table field "$OUT/build.log" "$2" "$1"; }
       p=$(kdf exponent exponent)
       if num "$p"; then
-        targets+=("kd-tree build CPU time ~ N^$p fitted to the medians (N^$(kdf exponent_best exponent) to the best runs), 10k to $BUILD_MAX triangles (target: exponent <= 1.15): $(verdict "$p <= 1.15")")
+        targets+=("kd-tree build CPU time ~ N^$p fitted to the medians (N^$(kdf exponent_best exponent) to the best runs), 10k to $BUILD_MAX triangles (target: exponent <= 1.15): $(verdict "$p" "<=" 1.15)")
       fi
       targets+=("tree size: $(kdf bytes_per_tri triangles) bytes/triangle at $(kdf triangles triangles) triangles (cube-sphere; no target)")
     else
@@ -723,19 +724,7 @@ if part rays; then
       emb=$([ "$k" = 0 ] && echo "$emb_p" || echo "$emb_r")
       ours=$(rvalues "$log" "$set" mrays)
       walk=$(rvalues "$log" "$set" bare_mrays)
-      dis=$(awk -v set="$set" '$1 == "result" && $2 == "set=" set && /agree=/ {
-              for (i = 3; i <= NF; i++) { split($i, kv, "="); v[kv[1]] = kv[2] }
-              s = v["disagree"] " of " v["agree"] + v["disagree"] " hits"
-              if (v["disagree"] > 0) {
-                s = s " ("; sep = ""
-                if (v["tie"]) { s = s sep v["tie"] " edge/vertex ties"; sep = ", " }
-                if (v["tfloat"]) { s = s sep v["tfloat"] " float t"; sep = ", " }
-                if (v["tdiff"]) { s = s sep v["tdiff"] " other t"; sep = ", " }
-                if (v["ours_only"]) { s = s sep v["ours_only"] " ours only"; sep = ", " }
-                if (v["embree_only"]) { s = s sep v["embree_only"] " Embree only"; sep = ", " }
-                s = s ")" }
-              last = s }
-              END { print last }' "$log")
+      dis=$(table disagree "$log" "$set")
       # shellcheck disable=SC2086
       m_ours=$(median $ours) m_walk=$(median $walk)
       e_med=- e_rng=- r_med=- r_rng=- rr_med=-
@@ -756,7 +745,7 @@ if part rays; then
       if [ "$mname" = sphere100k ] && [ "$kind" = primary ]; then
         if [ -n "$emb" ]; then
           # shellcheck disable=SC2086
-          targets+=("primary rays, sphere100k, one thread, CPU time, median of $RAYS_ROUNDS rounds taking turns: walk (triangle, t, u, v, Ng) $(printf %.2f "$m_walk") Mrays/s ($(range %.2f $walk)), Embree rtcIntersect1 $e_med Mrays/s $e_rng, ratio $r_med $r_rng (target >= 0.5): $(verdict "$r_med >= 0.5"); with nearest_hit's hit point, normal and material $(printf %.2f "$m_ours") Mrays/s, ratio $rr_med")
+          targets+=("primary rays, sphere100k, one thread, CPU time, median of $RAYS_ROUNDS rounds taking turns: walk (triangle, t, u, v, Ng) $(printf %.2f "$m_walk") Mrays/s ($(range %.2f $walk)), Embree rtcIntersect1 $e_med Mrays/s $e_rng, ratio $r_med $r_rng (target >= 0.5): $(verdict "$r_med" ">=" 0.5); with nearest_hit's hit point, normal and material $(printf %.2f "$m_ours") Mrays/s, ratio $rr_med")
         else
           targets+=("primary rays, sphere100k: walk $(printf %.2f "$m_walk") Mrays/s, nearest_hit $(printf %.2f "$m_ours") Mrays/s (CPU time); Embree $embree_why")
         fi
@@ -839,8 +828,7 @@ if part accel; then
             num "$(embree_field "$elog" primary)" && num "$(embree_field "$elog" random)"; then
             emb_b+="$(embree_field "$elog" build) "
             emb_p+="$(embree_field "$elog" primary) " emb_r+="$(embree_field "$elog" random) "
-            emb_pb+="$(grep -A1 'TRACE primary' "$elog" | sed -n 's/.*thread CPU time: best [0-9.]* s = \([0-9.]*\) Mrays.*/\1/p' | head -n 1) "
-            emb_rb+="$(grep -A1 'TRACE random' "$elog" | sed -n 's/.*thread CPU time: best [0-9.]* s = \([0-9.]*\) Mrays.*/\1/p' | head -n 1) "
+            emb_pb+="$(embree_field "$elog" primary-best) " emb_rb+="$(embree_field "$elog" random-best) "
           else
             say "accel: $mname: embree_rays failed, see $elog: no more rounds of it"
             embree='' embree_why="embree_rays failed, see $elog"
@@ -857,7 +845,7 @@ if part accel; then
         # this round's best structure (none and the recursive forms aside),
         # by its median, and its BVH's build
         ours_p+="$("$OUT/table" best "$rlog" primary) " ours_r+="$("$OUT/table" best "$rlog" random) "
-        sah_b+="$(awk '$1 == "result" && $3 == "accel=bvh-sah" { for (i = 4; i <= NF; i++) if ($i ~ /^build_s=/) { print substr($i, 9); exit } }' "$rlog") "
+        sah_b+="$(table build "$rlog" bvh-sah) "
       done
       if [ "$rc" != 0 ]; then
         printf '%-11s raybench failed, see %s\n' "$mname" "$log" | tee -a "$OUT/bench.txt"
@@ -867,14 +855,14 @@ if part accel; then
         if [ -n "$emb_p" ]; then
           # shellcheck disable=SC2086
           printf '%-11s %-10s %8.4f %7s  %6.2f %6.2f %6s   %6.2f %6.2f %6s   (build: %s, the median of %d runs, %s; trace: the best and the median of %d runs of 5)\n' \
-            "$mname" Embree "$(median $emb_b)" - "$(spread $emb_pb | awk '{ print $3 }')" "$(median $emb_p)" - \
-            "$(spread $emb_rb | awk '{ print $3 }')" "$(median $emb_r)" - "$embree_clock" "$(wc -w <<<"$emb_b")" \
+            "$mname" Embree "$(median $emb_b)" - "$(table greatest $emb_pb)" "$(median $emb_p)" - \
+            "$(table greatest $emb_rb)" "$(median $emb_r)" - "$embree_clock" "$(wc -w <<<"$emb_b")" \
             "$(range %.4f $emb_b)" "$(wc -w <<<"$emb_p")" | tee -a "$OUT/bench.txt"
           rp=$(ratios "$ours_p" "$emb_p") rr=$(ratios "$ours_r" "$emb_r") rb=$(ratios "$sah_b" "$emb_b")
           # shellcheck disable=SC2086
-          targets+=("sphere100k, one thread, CPU time, medians of $ROUNDS rounds taking turns: our best structure $(printf %.2f "$(median $ours_p)") Mrays/s primary against Embree $(printf %.2f "$(median $emb_p)"): $(printf %.2f "$(median $rp)")x ($(range %.2f $rp)) (target >= 0.8): $(verdict "$(median $rp) >= 0.8"); random $(printf %.2f "$(median $ours_r)") against $(printf %.2f "$(median $emb_r)"): $(printf %.2f "$(median $rr)")x ($(range %.2f $rr)) (target >= 0.5): $(verdict "$(median $rr) >= 0.5")")
+          targets+=("sphere100k, one thread, CPU time, medians of $ROUNDS rounds taking turns: our best structure $(printf %.2f "$(median $ours_p)") Mrays/s primary against Embree $(printf %.2f "$(median $emb_p)"): $(printf %.2f "$(median $rp)")x ($(range %.2f $rp)) (target >= 0.8): $(verdict "$(median $rp)" ">=" 0.8); random $(printf %.2f "$(median $ours_r)") against $(printf %.2f "$(median $emb_r)"): $(printf %.2f "$(median $rr)")x ($(range %.2f $rr)) (target >= 0.5): $(verdict "$(median $rr)" ">=" 0.5)")
           # shellcheck disable=SC2086
-          targets+=("sphere100k BVH SAH build $(printf %.4f "$(median $sah_b)") s (CPU) against Embree's $(printf %.4f "$(median $emb_b)") s ($embree_clock, one thread), medians of $ROUNDS rounds: $(printf %.2f "$(median $rb)")x ($(range %.2f $rb)) (target <= 1.5): $(verdict "$(median $rb) <= 1.5")")
+          targets+=("sphere100k BVH SAH build $(printf %.4f "$(median $sah_b)") s (CPU) against Embree's $(printf %.4f "$(median $emb_b)") s ($embree_clock, one thread), medians of $ROUNDS rounds: $(printf %.2f "$(median $rb)")x ($(range %.2f $rb)) (target <= 1.5): $(verdict "$(median $rb)" "<=" 1.5)")
         else
           echo "(Embree: ${embree_why:-not run}; the rays were made here by its conventions)" | tee -a "$OUT/bench.txt"
         fi
@@ -936,7 +924,7 @@ if part far; then
       # the lowest of them, then "accel ratio, ...", then DIFFER or nothing
       { read -r low; read -r line; read -r differ; } < <("$OUT/table" far "$log")
       [ -n "$differ" ] && { line="$line; answers DIFFER from the loop"; status=1; }
-      targets+=("far from the origin, sphere100k, one thread, CPU time: each structure's lowest ratio of its median Mrays/s (scene at 1e4, 1e6, 1e8; camera at 1e10, 1e13; primary and random rays) to its median at the origin: $line (target >= 0.8): $(verdict "${low:-0} >= 0.8")")
+      targets+=("far from the origin, sphere100k, one thread, CPU time: each structure's lowest ratio of its median Mrays/s (scene at 1e4, 1e6, 1e8; camera at 1e10, 1e13; primary and random rays) to its median at the origin: $line (target >= 0.8): $(verdict "${low:-0}" ">=" 0.8)")
     else
       echo "sphere100k: raybench far failed, see $log" | tee -a "$OUT/bench.txt"
       status=1
@@ -955,10 +943,18 @@ pov1() {
   took=$cpu
 }
 walls=()   # the wall clock of the whole runs, beside the table: no figure
-# pov_trace LOG: POV-Ray's CPU seconds of tracing ("Trace Time: ... using 1
-# thread(s) with X CPU-seconds total"), parsing and bounding aside.
+# The readers of POV-Ray's output.  pov_trace LOG: its CPU seconds of
+# tracing ("Trace Time: ... using 1 thread(s) with X CPU-seconds total", on
+# a line after "Trace Time:"), parsing and bounding aside.  pov_rays LOG:
+# its rays ("Rays: N") plus its shadow ray tests ("Shadow Ray Tests: N").
 pov_trace() {
-  awk '/Trace Time:/ { t = 1; next } t && /CPU-seconds total/ { sub(/.* with /, ""); print $1; exit }' "$1"
+  sed -n '0,/Trace Time:/d; /CPU-seconds total/ { s/.* with //; s/[[:blank:]].*//; p; q; }' "$1"
+}
+pov_rays() {
+  local r s
+  r=$(sed -n 's/^Rays:[[:blank:]]*\([0-9][0-9]*\).*/\1/p' "$1" | tail -n 1)
+  s=$(sed -n 's/^Shadow Ray Tests:[[:blank:]]*\([0-9][0-9]*\).*/\1/p' "$1" | tail -n 1)
+  [ -z "$r" ] || echo $((r + ${s:-0}))
 }
 
 if part pov; then
@@ -1032,18 +1028,18 @@ if part pov; then
       cmp -s "$OUT/pov-none-balls.ppm" "$OUT/pov-ours-$nff.ppm" || { same=DIFFER; status=1; }
       sp=$(ratios "$none_r" "$ours_r")
       # shellcheck disable=SC2086
-      targets+=("balls_s4 512x512, one thread: render CPU kd $(printf %.3f "$m_or") s ($(range %.3f $ours_r)), --accel none $(printf %.2f "$(median $none_r)") s ($(range %.2f $none_r), $(wc -w <<<"$none_r") runs) (images $same), speed-up $(printf %.0f "$(median $sp)")x ($(range %.0f $sp), the rounds' ratios) (target >= 100x): $(verdict "$(median $sp) >= 100")")
+      targets+=("balls_s4 512x512, one thread: render CPU kd $(printf %.3f "$m_or") s ($(range %.3f $ours_r)), --accel none $(printf %.2f "$(median $none_r)") s ($(range %.2f $none_r), $(wc -w <<<"$none_r") runs) (images $same), speed-up $(printf %.0f "$(median $sp)")x ($(range %.0f $sp), the rounds' ratios) (target >= 100x): $(verdict "$(median $sp)" ">=" 100)")
     elif [ "$nff" = balls_s4 ] && [ -n "$balls_none_us" ]; then
       # BENCH_BALLS_NONE_FULL=0: brute force's time per ray at the spd section's
       # size stands for the 512x512 render.
       read -r none_us none_size <<<"$balls_none_us"
-      ku=$(awk "BEGIN { printf \"%.4f\", $m_or / $ours_rays * 1e6 }")
-      sp=$(awk "BEGIN { printf \"%.0f\", $none_us / $ku }")
-      targets+=("balls_s4 512x512, one thread: kd ${ku} us/ray, --accel none $none_us us/ray (measured at $none_size: CPU time per ray), speed-up ${sp}x (target >= 100x): $(verdict "$sp >= 100")")
+      ku=$(table us-per "$m_or" "$ours_rays" %.4f)
+      sp=$(ratio %.0f "$none_us" "$ku")
+      targets+=("balls_s4 512x512, one thread: kd ${ku} us/ray, --accel none $none_us us/ray (measured at $none_size: CPU time per ray), speed-up ${sp}x (target >= 100x): $(verdict "$sp" ">=" 100)")
     fi
     if [ -n "$pov_w" ]; then
       xw=$(ratios "$pov_w" "$ours_w") xr=$(ratios "$pov_t" "$ours_r")
-      pov_rays=$(awk '/^Rays:/ { r = $2 } /^Shadow Ray Tests:/ { s = $4 } END { if (r != "") print r + s }' "$OUT/pov-$pov.log")
+      pov_rays=$(pov_rays "$OUT/pov-$pov.log")
       # shellcheck disable=SC2086
       printf '%-11s %-11s %7.3f %-13s %7.3f %7.3f %-13s %7.3f %7.2f %-11s %8.2f %-11s %9s %9s\n' "$pov" "$nff" "$m_ow" \
         "($(range %.3f $ours_w))" "$m_or" "$(median $pov_w)" "($(range %.3f $pov_w))" "$(median $pov_t)" \
@@ -1055,7 +1051,7 @@ if part pov; then
         "$(median $q)")")
       if [ "$nff" = balls_s4 ]; then
         # shellcheck disable=SC2086
-        targets+=("balls_s4 512x512, one thread, CPU of whole runs, median of $ROUNDS rounds taking turns: ours $(printf %.3f "$m_ow") s, POV-Ray 3.7 $(printf %.3f "$(median $pov_w)") s, POV-Ray over ours $(printf %.2f "$(median $xw)") ($(range %.2f $xw)) (render $(printf %.3f "$m_or") s against trace $(printf %.3f "$(median $pov_t)") s: $(printf %.2f "$(median $xr)")) (target: faster than POV-Ray): $(verdict "$(median $xw) > 1")")
+        targets+=("balls_s4 512x512, one thread, CPU of whole runs, median of $ROUNDS rounds taking turns: ours $(printf %.3f "$m_ow") s, POV-Ray 3.7 $(printf %.3f "$(median $pov_w)") s, POV-Ray over ours $(printf %.2f "$(median $xw)") ($(range %.2f $xw)) (render $(printf %.3f "$m_or") s against trace $(printf %.3f "$(median $pov_t)") s: $(printf %.2f "$(median $xr)")) (target: faster than POV-Ray): $(verdict "$(median $xw)" ">" 1)")
       fi
     else
       # shellcheck disable=SC2086
