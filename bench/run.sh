@@ -1,4 +1,27 @@
 #!/usr/bin/env bash
+# bench/run.sh, to read first.  The shell builds, runs and times; the
+# arithmetic of every table, and the reading of our own programs' logs, is
+# bench/table.c's (`table SUBCOMMAND`, the list at its top); Embree's and
+# POV-Ray's output is read by one shell function each (embree_field,
+# pov_trace, pov_rays).  Each section, what it measures, and what computes
+# its table:
+#   render  CPU time against RMSE of the double and float builds: tools/ppmdiff
+#           (the error), table render (the rows of bench.tsv), bench/svgplot.c
+#   spd     kd-tree against brute force on the SPD scenes, us/ray: ./ray
+#           --stats=kv, table us-per, median, range, ratios
+#   build   build time against N of every structure: bench/raybench.c build
+#           prints its table; table field reads the fit for the targets
+#   rays    traversal against Embree on the same rays: raybench rays/made;
+#           table values, field, disagree; embree_field
+#   accel   every structure on the same rays: raybench accel; table accel, best
+#   anim    the structures under animation: raybench anim prints its table
+#   far     far from the origin: raybench far prints it; table far, the target
+#   pov     ours against POV-Ray 3.7: ./ray --stats=kv, pov_trace, pov_rays;
+#           table median, range, ratios
+#   pt      the path tracer's estimators: bench/pt.sh (bench/pfmerr.c; table
+#           pt-slopes, pt-plot, time-at)
+# and at the end the targets, each with its figures: table verdict.
+#
 # make bench: the Whitted renderer's time against its error, and the kd-tree
 # against brute force, against itself at growing N, against Embree and
 # against POV-Ray.
