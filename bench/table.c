@@ -1,7 +1,7 @@
-/* bench/table.c: the arithmetic of bench/run.sh's tables, which the shell
- * runs and times.  C99, libc and libm.  Numbers come as arguments (lists
- * may be one argument of words, as the shell's "$t_double" is) or, for the
- * raybench readers, from the log named.
+/* bench/table.c: the arithmetic of bench/run.sh's and bench/pt.sh's
+ * tables, and the readers of our own programs' logs; the shell runs and
+ * times.  C99, libc and libm.  Numbers come as arguments (lists may be one
+ * argument of words, as the shell's "$t_double" is) or from the file named.
  *
  *   table spread V...       "least median greatest" (the median of an even
  *                           count: the mean of the two in the middle)
