@@ -282,7 +282,7 @@ typedef struct {
     Counts count;
     int blocker[SHADOW_SLOTS];  /* light i's last blocker, or -1, in slot i % SHADOW_SLOTS */
     unsigned long long key;     /* the path tracer's random numbers: which sample, */
-    unsigned dim;               /* and how many it has drawn (see random01) */
+    int bounce;                 /* and which bounce its path is at (see random01) */
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
 } Worker;
 
@@ -354,12 +354,15 @@ static vec pixel_view(const Scene *s, int i, int j, Worker *wk);   /* --view, in
 /* samples: the points of a pixel, random numbers, the warps and their pdfs */
 static void sample_offset(int k, real anchor, real *dx, real *dy);
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
-static real random01(Worker *wk);
+static real random01(const Worker *wk, unsigned dim);
+static real bounce_random(const Worker *wk, int slot);
 static vec from_local(vec n, vec l);
 static vec cosine_hemisphere(real u1, real u2);
 static real cosine_hemisphere_pdf(real cos_theta);
 static vec phong_lobe(real shine, real u1, real u2);
 static real phong_lobe_pdf(real shine, real cos_alpha);
+static vec uniform_disc(real u1, real u2);
+static real uniform_disc_pdf(void);
 static vec sphere_cap(real cap, real u1, real u2);
 static real sphere_cap_pdf(real cap);
 static vec uniform_triangle(real u1, real u2);
@@ -537,14 +540,14 @@ static void sample_offset(int k, real anchor, real *dx, real *dy)
     if (*dy >= anchor + 0.5) *dy -= 1;
 }
 
-/* Random numbers without a generator's state: the n-th number of sample k
- * of pixel p is a hash of (seed, p, k, n).  So a pixel's noise does not
- * depend on which thread computes it, nor on the order, and any part of an
- * image can be rendered apart and put together exactly.  (smallpt seeds a
- * generator per row with y^3 cut to 16 bits, which gives rows 0, 64,
- * 128, ... the same noise.)  The hash is the finaliser of SplitMix64
- * (Steele, Lea and Flood, "Fast splittable pseudorandom number generators",
- * OOPSLA 2014), applied once per key and once per number. */
+/* Random numbers without a generator's state: the number in dimension d
+ * of sample k of pixel p is a hash of (seed, p, k, d).  So a pixel's noise
+ * does not depend on which thread computes it, nor on the order, and any
+ * part of an image can be rendered apart and put together exactly.
+ * (smallpt seeds a generator per row with y^3 cut to 16 bits, which gives
+ * rows 0, 64, 128, ... the same noise.)  The hash is the finaliser of
+ * SplitMix64 (Steele, Lea and Flood, "Fast splittable pseudorandom number
+ * generators", OOPSLA 2014), applied once per key and once per number. */
 static unsigned long long mix64(unsigned long long z)
 {
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
@@ -552,19 +555,59 @@ static unsigned long long mix64(unsigned long long z)
     return z ^ (z >> 31);
 }
 
+/* The dimensions of a sample.  A path is one point of a unit cube of many
+ * dimensions, each coordinate a number some choice along it is made from
+ * (Keller, "Quasi-Monte Carlo image synthesis in a nutshell", 2013).  Here
+ * every choice has its own named dimension, the same in every path, rather
+ * than taking the next number drawn: so a choice that is made in one path
+ * and not in another (a light sampled by nee and not by bsdf, roulette
+ * only from ROULETTE_FROM rays on), or a lens or a time sampled one day,
+ * leaves every other number of every path where it was, and an image's
+ * noise changes only where the change itself reaches.
+ *
+ *     dimension             what it chooses                   drawn by
+ *     DIM_PIXEL_X, _Y       the pixel's shift of its samples  sample_radiance, once a
+ *                           (Cranley-Patterson)                 pixel (as its sample -1)
+ *     DIM_LENS_U, _V        a point of the lens               reserved: no lens yet
+ *     DIM_TIME              an instant of the shutter         reserved: no motion yet
+ *   and from DIM_BOUNCE on, a block of BOUNCE_DIMS for each bounce b (0 at the
+ *   first hit), slot k of it dimension DIM_BOUNCE + b * BOUNCE_DIMS + k:
+ *       LIGHT_CHOICE        which light                       sample_light
+ *       LIGHT_U, LIGHT_V    the point on it                   sample_emitter
+ *       LOBE                which lobe of the BSDF, and       sample_bsdf
+ *                           glass's reflect or refract          (see sample_glass)
+ *       DIRECTION_U, _V     the direction within the lobe     sample_bsdf
+ *       ROULETTE            whether the path goes on          survives
+ *       SPARE               none yet: room for one more
+ *
+ * The lens and time dimensions are kept now, unused, so that a thin lens
+ * or motion blur added later takes its numbers from them and moves no
+ * other path's. */
+enum { DIM_PIXEL_X, DIM_PIXEL_Y, DIM_LENS_U, DIM_LENS_V, DIM_TIME, DIM_BOUNCE };
+enum { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE, SPARE,
+       BOUNCE_DIMS };
+
+/* The sample the numbers that follow belong to: sample k of pixel (i, j),
+ * its path at the first hit. */
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k)
 {
     unsigned long long pixel = (unsigned long long)j * (unsigned)s->w + (unsigned)i;
     wk->key = mix64(mix64(mix64(s->seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
-    wk->dim = 0;
+    wk->bounce = 0;
 }
 
-/* The next random number of the sample, uniform in [0, 1). */
-static real random01(Worker *wk)
+/* The sample's number in dimension dim, uniform in [0, 1). */
+static real random01(const Worker *wk, unsigned dim)
 {
-    unsigned long long h = mix64(wk->key + 0x9e3779b97f4a7c15ULL * ++wk->dim);
+    unsigned long long h = mix64(wk->key + 0x9e3779b97f4a7c15ULL * (dim + 1ULL));
     real u = (real)((h >> 11) * (1.0 / 9007199254740992.0));
     return u < 1 ? u : 1 - REAL_EPS;      /* a float may round up to 1 */
+}
+
+/* The number in `slot` of the block of the bounce the path is at. */
+static real bounce_random(const Worker *wk, int slot)
+{
+    return random01(wk, DIM_BOUNCE + (unsigned)wk->bounce * BOUNCE_DIMS + (unsigned)slot);
 }
 
 /* The warps below work in a local frame about the z axis; this turns a
@@ -580,18 +623,20 @@ static vec from_local(vec n, vec l)
 }
 
 /* A direction of the hemisphere about z with pdf cos(theta)/pi, the
- * Lambertian lobe (Malley's method: a uniform point of the unit disc,
- * lifted onto the hemisphere). */
+ * Lambertian lobe, by Malley's method: a uniform point of the unit disc
+ * lifted straight up onto the hemisphere.  The disc's area element is the
+ * solid angle's times cos(theta), the disc being the hemisphere seen from
+ * above, so the pdf the point had on the disc, 1/pi, becomes cos(theta)/pi. */
 static vec cosine_hemisphere(real u1, real u2)
 {
-    real r = sqrt(u1), phi = 2 * (real)PI * u2;
-    return v3(r * cos(phi), r * sin(phi), sqrt(fmax(0, 1 - u1)));
+    vec d = uniform_disc(u1, u2);
+    return v3(d.x, d.y, sqrt(fmax(0, 1 - d.x * d.x - d.y * d.y)));
 }
 
 /* Its pdf in solid angle: cos(theta)/pi above the horizon, 0 below. */
 static real cosine_hemisphere_pdf(real cos_theta)
 {
-    return cos_theta > 0 ? cos_theta / (real)PI : 0;
+    return cos_theta > 0 ? uniform_disc_pdf() * cos_theta : 0;
 }
 
 /* A direction about z with pdf (shine+1)/(2 pi) cos^shine(alpha), alpha
@@ -608,6 +653,32 @@ static vec phong_lobe(real shine, real u1, real u2)
 static real phong_lobe_pdf(real shine, real cos_alpha)
 {
     return cos_alpha > 0 ? (shine + 1) / (2 * (real)PI) * pow(cos_alpha, shine) : 0;
+}
+
+/* A uniform point (x, y, 0) of the unit disc, for cosine_hemisphere and
+ * one day a thin lens: the concentric map of Shirley and Chiu ("A Low Distortion Map Between Disk
+ * and Square", JGT 2(3), 1997), which sends the square's concentric
+ * squares to the disc's concentric circles, so that points spread evenly
+ * over the square stay spread evenly over the disc (the polar map
+ * r = sqrt(u1) squeezes and stretches them). */
+static vec uniform_disc(real u1, real u2)
+{
+    real a = 2 * u1 - 1, b = 2 * u2 - 1, r, phi;
+    if (a == 0 && b == 0) return v3(0, 0, 0);
+    if (fabs(a) > fabs(b)) {                    /* the wedges left and right */
+        r = a;
+        phi = (real)PI / 4 * (b / a);
+    } else {                                    /* top and bottom */
+        r = b;
+        phi = (real)PI / 2 - (real)PI / 4 * (a / b);
+    }
+    return v3(r * cos(phi), r * sin(phi), 0);
+}
+
+/* Its pdf in area: 1/pi on the unit disc. */
+static real uniform_disc_pdf(void)
+{
+    return 1 / (real)PI;
 }
 
 /* A uniform direction of the cone about z whose cap of the unit sphere has
@@ -848,8 +919,8 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     Path path;
     real dx, dy, sx, sy;
     start_sample(wk, s, i, j, -1);          /* the pixel's shift: no sample's numbers */
-    sx = random01(wk);
-    sy = random01(wk);
+    sx = random01(wk, DIM_PIXEL_X);
+    sy = random01(wk, DIM_PIXEL_Y);
     sample_offset(k, (real)0.5, &dx, &dy);
     dx += sx;
     dy += sy;
@@ -877,6 +948,9 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
     Le = emitted(s, &h, wo, path);
     if (path->rays == s->max_rays || path->rays == MAX_PATH) return Le;
     bsdf_at(s, &h, wo, &b);
+    /* this hit's block of random numbers; the next hit sets its own, and
+     * nothing below draws after radiance() of the next ray returns */
+    wk->bounce = path->rays - 1;
     direct = s->estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
     lobe = sample_bsdf(&b, wo, wk, &next.from, &f_cos, &pdf);   /* next.from: wi */
     if (lobe < 0) return add(Le, direct);
@@ -902,7 +976,7 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
     if (m < beta->z) m = beta->z;
     if (!s->roulette || rays < ROULETTE_FROM) return 1;
     q = m < (real)0.95 ? m : (real)0.95;
-    if (!(random01(wk) < q)) return 0;
+    if (!(bounce_random(wk, ROULETTE) < q)) return 0;
     *beta = scale(1 / q, *beta);
     *f_cos = scale(1 / q, *f_cos);
     return 1;
@@ -954,7 +1028,7 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
 {
     vec wi, Le, f;
     real dist, pdf, cosi;
-    int l = choose_light(s, random01(wk)), delta;
+    int l = choose_light(s, bounce_random(wk, LIGHT_CHOICE)), delta;
     Ray r;
     if (l < 0) return v3(0, 0, 0);
     delta = sample_emitter(s, l, h->p, b->n, wk, &wi, &dist, &Le, &pdf);
@@ -1000,7 +1074,7 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *
 {
     const Emitter *e = &s->emit[l];
     const Material *m;
-    real u = random01(wk), v = random01(wk);
+    real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V);
     vec y, ny;
     int k;
     *pdf = 0;
@@ -1123,7 +1197,8 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
  * light is absorbed, or the direction fell below the surface). */
 static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf)
 {
-    real u = random01(wk), u1 = random01(wk), u2 = random01(wk), cosi = dot(wo, b->n);
+    real u = bounce_random(wk, LOBE), cosi = dot(wo, b->n);
+    real u1 = bounce_random(wk, DIRECTION_U), u2 = bounce_random(wk, DIRECTION_V);
     int lobe = 0;
     *pdf = 0;
     while (lobe < GLASS_LOBE && u >= b->p[lobe]) u -= b->p[lobe++];
@@ -1152,7 +1227,11 @@ static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, r
  * chance, so the weight is the lobe's alone, times eta^2 through the
  * surface: radiance is crowded into a narrower cone entering a denser
  * medium, and spreads out leaving it (the same factor, inverted, so a
- * path in and out again gets the two back to 1). */
+ * path in and out again gets the two back to 1).  u is what is left of the
+ * number that chose the lobe, rescaled to [0, 1): given that glass was
+ * chosen, it is again uniform and tells nothing of the choice, so it can
+ * choose once more, and the choice needs no dimension of its own (the
+ * LOBE slot serves both; SPARE stays free). */
 static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos)
 {
     real cosi = dot(wo, b->n), w = b->glass / b->p[GLASS_LOBE];
