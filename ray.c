@@ -30,10 +30,11 @@
  *
  * HOW TO READ IT.  The lecture comes first, in the order a ray meets it:
  * the types, the vectors, a table of contents (the prototypes), then
- * "for each pixel", RayTrace(R) (Whitted), L = Le + integral f L cos
- * (Kajiya), finding hits, and the primitives.  After
- * the line THE PLUMBING come threads, scene files, output and main(); a
- * student can stop reading there.
+ * "for each pixel", the samples (the points of a pixel, random numbers,
+ * and the warps that turn them into points and directions, each with its
+ * pdf), RayTrace(R) (Whitted), L = Le + integral f L cos (Kajiya), finding
+ * hits, and the primitives.  After the line THE PLUMBING come threads,
+ * scene files, output and main(); a student can stop reading there.
  *
  * The lecture's pseudo-code, and the functions that do it:
  *
@@ -61,15 +62,15 @@
  *                                                   Li = radiance() of the next point
  *
  * One primary ray of Whitted's, from main() to its pixel's byte.  Each function is
- * defined below the one before it, except the seven marked ^, which a
+ * defined below the one before it, except the eight marked ^, which a
  * reader finds further up:
  *
  *       main()            reads the scene, builds the tree          (plumbing)
  *     ^ render()          shares the rows out among threads         (plumbing)
  *     ^ render_row()      for each pixel of a row                   for each pixel
  *       pixel_color()     averages the pixel's samples
- *       sample_offset()   where sample k lies in the pixel
- *       camera_ray()      the ray R from the eye through it
+ *       sample_offset()   where sample k lies in the pixel          samples
+ *     ^ camera_ray()      the ray R from the eye through it         for each pixel
  *       trace()           RayTrace(R)                               RayTrace(R)
  *       nearest_hit()     the nearest hit                           finding hits
  *       query()           the record the tree hands back
@@ -279,7 +280,7 @@ typedef struct {
     Counts count;
     int blocker[SHADOW_SLOTS];  /* light i's last blocker, or -1, in slot i % SHADOW_SLOTS */
     unsigned long long key;     /* the path tracer's random numbers: which sample, */
-    unsigned dim;               /* and how many it has drawn (see random01) */
+    int bounce;                 /* and which bounce its path is at (see random01) */
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
     const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
     long long *splat;           /* this thread's splat image (see splat()), or NULL */
@@ -350,13 +351,29 @@ static void box_union(double lo[3], double hi[3], const double lo2[3], const dou
 /* for each pixel */
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
-static void sample_offset(int k, real anchor, real *dx, real *dy);
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
 static int set_camera(Scene *s, const real *v, char *why);
 static void put_pixel(Image *img, int i, int j, vec c);
 static unsigned char to_byte(real v);
 static real srgb(real v);
 static vec pixel_view(const Scene *s, int i, int j, Worker *wk);   /* --view, in the plumbing */
+
+/* samples: the points of a pixel, random numbers, the warps and their pdfs */
+static void sample_offset(int k, real anchor, real *dx, real *dy);
+static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
+static real random01(const Worker *wk, unsigned dim);
+static real bounce_random(const Worker *wk, int slot);
+static vec from_local(vec n, vec l);
+static vec cosine_hemisphere(real u1, real u2);
+static real cosine_hemisphere_pdf(real cos_theta);
+static vec phong_lobe(real shine, real u1, real u2);
+static real phong_lobe_pdf(real shine, real cos_alpha);
+static vec uniform_disc(real u1, real u2);
+static real uniform_disc_pdf(void);
+static vec sphere_cap(real cap, real u1, real u2);
+static real sphere_cap_pdf(real cap);
+static vec uniform_triangle(real u1, real u2);
+static real uniform_triangle_pdf(real area);
 
 /* RayTrace(R): Whitted's recursive ray tracing */
 static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
@@ -391,11 +408,6 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi);
 static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf);
 static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos);
 static real fresnel(real cosi, real eta);
-static vec cosine_direction(vec n, real u1, real u2);
-static vec phong_direction(vec m, real shine, real u1, real u2);
-static vec from_local(vec n, real x, real y, real z);
-static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
-static real random01(Worker *wk);
 
 /* finding hits: the only code that knows an acceleration structure exists */
 static int nearest_hit(const Scene *s, Ray r, Hit *h, Worker *wk);
@@ -469,20 +481,6 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
     return scale((real)1 / spp, sum);
-}
-
-/* Sample k of n inside a pixel: the R2 low-discrepancy sequence (Roberts,
- * "The unreasonable effectiveness of quasirandom sequences", 2018), which
- * spreads any number of points evenly and needs no random numbers, so every
- * run gives the same bytes.  Sample 0 lies on the anchor: the pixel's centre,
- * or with `pixel corner` its top-left corner, where minray aims. */
-static void sample_offset(int k, real anchor, real *dx, real *dy)
-{
-    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* 1/g, 1/g^2; g^3 = g + 1 */
-    *dx = (real)(anchor + (k * a1 - floor(k * a1)));   /* the fraction: exact */
-    *dy = (real)(anchor + (k * a2 - floor(k * a2)));
-    if (*dx >= anchor + 0.5) *dx -= 1;          /* wrap into [anchor-1/2, anchor+1/2) */
-    if (*dy >= anchor + 0.5) *dy -= 1;
 }
 
 /* The primary ray through image point (x, y), in pixels from the top-left
@@ -592,6 +590,207 @@ static unsigned char to_byte(real v)
 static real srgb(real v)
 {
     return v <= (real)0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+}
+
+/* ----------------------------------------------------------------- samples */
+
+/* Where the numbers come from: the points of a pixel (the R2 pattern), the
+ * path tracer's random numbers, and the warps that turn two uniform numbers
+ * into a point or a direction with a known density.  Each warp stands
+ * beside its pdf, named alike (cosine_hemisphere, cosine_hemisphere_pdf),
+ * as Nori's warp.h pairs them (Jakob's educational renderer), so that
+ * whoever divides by a pdf calls the function that says it, and a test can
+ * hold each warp against its pdf (tests/test_pt.c, "warp" checks). */
+
+/* Sample k of n inside a pixel: the R2 low-discrepancy sequence (Roberts,
+ * "The unreasonable effectiveness of quasirandom sequences", 2018), which
+ * spreads any number of points evenly and needs no random numbers, so every
+ * run gives the same bytes.  Sample 0 lies on the anchor: the pixel's centre,
+ * or with `pixel corner` its top-left corner, where minray aims. */
+static void sample_offset(int k, real anchor, real *dx, real *dy)
+{
+    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* 1/g, 1/g^2; g^3 = g + 1 */
+    *dx = (real)(anchor + (k * a1 - floor(k * a1)));   /* the fraction: exact */
+    *dy = (real)(anchor + (k * a2 - floor(k * a2)));
+    if (*dx >= anchor + 0.5) *dx -= 1;          /* wrap into [anchor-1/2, anchor+1/2) */
+    if (*dy >= anchor + 0.5) *dy -= 1;
+}
+
+/* Random numbers without a generator's state: the number in dimension d
+ * of sample k of pixel p is a hash of (seed, p, k, d).  So a pixel's noise
+ * does not depend on which thread computes it, nor on the order, and any
+ * part of an image can be rendered apart and put together exactly.
+ * (smallpt seeds a generator per row with y^3 cut to 16 bits, which gives
+ * rows 0, 64, 128, ... the same noise.)  The hash is the finaliser of
+ * SplitMix64 (Steele, Lea and Flood, "Fast splittable pseudorandom number
+ * generators", OOPSLA 2014), applied once per key and once per number. */
+static unsigned long long mix64(unsigned long long z)
+{
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* The dimensions of a sample.  A path is one point of a unit cube of many
+ * dimensions, each coordinate a number some choice along it is made from
+ * (Keller, "Quasi-Monte Carlo image synthesis in a nutshell", 2013).  Here
+ * every choice has its own named dimension, the same in every path, rather
+ * than taking the next number drawn: so a choice that is made in one path
+ * and not in another (a light sampled by nee and not by bsdf, roulette
+ * only from ROULETTE_FROM rays on), or a lens or a time sampled one day,
+ * leaves every other number of every path where it was, and an image's
+ * noise changes only where the change itself reaches.
+ *
+ *     dimension             what it chooses                   drawn by
+ *     DIM_PIXEL_X, _Y       the pixel's shift of its samples  sample_radiance, once a
+ *                           (Cranley-Patterson)                 pixel (as its sample -1)
+ *     DIM_LENS_U, _V        a point of the lens               reserved: no lens yet
+ *     DIM_TIME              an instant of the shutter         reserved: no motion yet
+ *   and from DIM_BOUNCE on, a block of BOUNCE_DIMS for each bounce b (0 at the
+ *   first hit), slot k of it dimension DIM_BOUNCE + b * BOUNCE_DIMS + k:
+ *       LIGHT_CHOICE        which light                       sample_light
+ *       LIGHT_U, LIGHT_V    the point on it                   sample_emitter
+ *       LOBE                which lobe of the BSDF, and       sample_bsdf
+ *                           glass's reflect or refract          (see sample_glass)
+ *       DIRECTION_U, _V     the direction within the lobe     sample_bsdf
+ *       ROULETTE            whether the path goes on          survives
+ *       SPARE               none yet: room for one more
+ *
+ * The lens and time dimensions are kept now, unused, so that a thin lens
+ * or motion blur added later takes its numbers from them and moves no
+ * other path's. */
+enum { DIM_PIXEL_X, DIM_PIXEL_Y, DIM_LENS_U, DIM_LENS_V, DIM_TIME, DIM_BOUNCE };
+enum { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE, SPARE,
+       BOUNCE_DIMS };
+
+/* The sample the numbers that follow belong to: sample k of pixel (i, j),
+ * its path at the first hit. */
+static void start_sample(Worker *wk, const Scene *s, int i, int j, int k)
+{
+    unsigned long long pixel = (unsigned long long)j * (unsigned)s->w + (unsigned)i;
+    wk->key = mix64(mix64(mix64(s->seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
+    wk->bounce = 0;
+}
+
+/* The sample's number in dimension dim, uniform in [0, 1). */
+static real random01(const Worker *wk, unsigned dim)
+{
+    unsigned long long h = mix64(wk->key + 0x9e3779b97f4a7c15ULL * (dim + 1ULL));
+    real u = (real)((h >> 11) * (1.0 / 9007199254740992.0));
+    return u < 1 ? u : 1 - REAL_EPS;      /* a float may round up to 1 */
+}
+
+/* The number in `slot` of the block of the bounce the path is at. */
+static real bounce_random(const Worker *wk, int slot)
+{
+    return random01(wk, DIM_BOUNCE + (unsigned)wk->bounce * BOUNCE_DIMS + (unsigned)slot);
+}
+
+/* The warps below work in a local frame about the z axis; this turns a
+ * local vector into the world's: l.x t1 + l.y t2 + l.z n for an
+ * orthonormal t1, t2 made from the unit vector n (Duff et al., "Building
+ * an Orthonormal Basis, Revisited", JCGT 6(1), 2017). */
+static vec from_local(vec n, vec l)
+{
+    real sign = n.z >= 0 ? 1 : -1, a = -1 / (sign + n.z), b = n.x * n.y * a;
+    vec t1 = v3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    vec t2 = v3(b, sign + n.y * n.y * a, -n.y);
+    return add(add(scale(l.x, t1), scale(l.y, t2)), scale(l.z, n));
+}
+
+/* A direction of the hemisphere about z with pdf cos(theta)/pi, the
+ * Lambertian lobe, by Malley's method: a uniform point of the unit disc
+ * lifted straight up onto the hemisphere.  The disc's area element is the
+ * solid angle's times cos(theta), the disc being the hemisphere seen from
+ * above, so the pdf the point had on the disc, 1/pi, becomes cos(theta)/pi. */
+static vec cosine_hemisphere(real u1, real u2)
+{
+    vec d = uniform_disc(u1, u2);
+    return v3(d.x, d.y, sqrt(fmax(0, 1 - d.x * d.x - d.y * d.y)));
+}
+
+/* Its pdf in solid angle: cos(theta)/pi above the horizon, 0 below. */
+static real cosine_hemisphere_pdf(real cos_theta)
+{
+    return cos_theta > 0 ? uniform_disc_pdf() * cos_theta : 0;
+}
+
+/* A direction about z with pdf (shine+1)/(2 pi) cos^shine(alpha), alpha
+ * its angle to z: the lobe of the modified Phong BRDF (Lafortune and
+ * Willems, "Using the modified Phong reflectance model for physically based
+ * rendering", 1994), by inverting the cdf 1 - cos^(shine+1) of alpha. */
+static vec phong_lobe(real shine, real u1, real u2)
+{
+    real c = pow(u1, 1 / (shine + 1)), s = sqrt(fmax(0, 1 - c * c)), phi = 2 * (real)PI * u2;
+    return v3(s * cos(phi), s * sin(phi), c);
+}
+
+/* Its pdf in solid angle, for cos_alpha the cosine of the angle to z. */
+static real phong_lobe_pdf(real shine, real cos_alpha)
+{
+    return cos_alpha > 0 ? (shine + 1) / (2 * (real)PI) * pow(cos_alpha, shine) : 0;
+}
+
+/* A uniform point (x, y, 0) of the unit disc, for cosine_hemisphere and
+ * one day a thin lens: the concentric map of Shirley and Chiu ("A Low Distortion Map Between Disk
+ * and Square", JGT 2(3), 1997), which sends the square's concentric
+ * squares to the disc's concentric circles, so that points spread evenly
+ * over the square stay spread evenly over the disc (the polar map
+ * r = sqrt(u1) squeezes and stretches them). */
+static vec uniform_disc(real u1, real u2)
+{
+    real a = 2 * u1 - 1, b = 2 * u2 - 1, r, phi;
+    if (a == 0 && b == 0) return v3(0, 0, 0);
+    if (fabs(a) > fabs(b)) {                    /* the wedges left and right */
+        r = a;
+        phi = (real)PI / 4 * (b / a);
+    } else {                                    /* top and bottom */
+        r = b;
+        phi = (real)PI / 2 - (real)PI / 4 * (a / b);
+    }
+    return v3(r * cos(phi), r * sin(phi), 0);
+}
+
+/* Its pdf in area: 1/pi on the unit disc. */
+static real uniform_disc_pdf(void)
+{
+    return 1 / (real)PI;
+}
+
+/* A uniform direction of the cone about z whose cap of the unit sphere has
+ * height cap = 1 - cos(theta_max) (2: the whole sphere).  Archimedes: the
+ * area of a sphere between two heights is proportional to their
+ * difference, so cos(theta) is uniform in [1 - cap, 1].  The cone comes
+ * as its cap's height, not as cos(theta_max): a far, small sphere light's
+ * cone has a cap a caller can compute without cancelling (sphere_sample),
+ * where cos(theta_max) would round to 1. */
+static vec sphere_cap(real cap, real u1, real u2)
+{
+    real c = 1 - u1 * cap, s = sqrt(fmax(0, 1 - c * c)), phi = 2 * (real)PI * u2;
+    return v3(s * cos(phi), s * sin(phi), c);
+}
+
+/* Its pdf in solid angle: one over the cap's area 2 pi cap. */
+static real sphere_cap_pdf(real cap)
+{
+    return 1 / (2 * (real)PI * cap);
+}
+
+/* A uniform point of a triangle, as its barycentrics (b0, b1, b2), the
+ * weights of its three corners (Turk, "Generating random points in
+ * triangles", Graphics Gems, 1990): sqrt(u1) picks the line parallel to
+ * the edge opposite corner 0, whose length grows with that distance, and
+ * u2 a point along it. */
+static vec uniform_triangle(real u1, real u2)
+{
+    real su = sqrt(u1);
+    return v3(1 - su, su * (1 - u2), su * u2);
+}
+
+/* Its pdf in area, for a triangle of that area. */
+static real uniform_triangle_pdf(real area)
+{
+    return 1 / area;
 }
 
 /* ------------------------------------------------------------- RayTrace(R) */
@@ -797,8 +996,8 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     Path path;
     real dx, dy, sx, sy;
     start_sample(wk, s, i, j, -1);          /* the pixel's shift: no sample's numbers */
-    sx = random01(wk);
-    sy = random01(wk);
+    sx = random01(wk, DIM_PIXEL_X);
+    sy = random01(wk, DIM_PIXEL_Y);
     sample_offset(k, (real)0.5, &dx, &dy);
     dx += sx;
     dy += sy;
@@ -826,6 +1025,9 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
     Le = emitted(s, &h, wo, path);
     if (path->rays == s->max_rays || path->rays == MAX_PATH) return Le;
     bsdf_at(s, &h, wo, &b);
+    /* this hit's block of random numbers; the next hit sets its own, and
+     * nothing below draws after radiance() of the next ray returns */
+    wk->bounce = path->rays - 1;
     direct = s->estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
     lobe = sample_bsdf(&b, wo, wk, &next.from, &f_cos, &pdf);   /* next.from: wi */
     if (lobe < 0) return add(Le, direct);
@@ -851,7 +1053,7 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
     if (m < beta->z) m = beta->z;
     if (!s->roulette || rays < ROULETTE_FROM) return 1;
     q = m < (real)0.95 ? m : (real)0.95;
-    if (!(random01(wk) < q)) return 0;
+    if (!(bounce_random(wk, ROULETTE) < q)) return 0;
     *beta = scale(1 / q, *beta);
     *f_cos = scale(1 / q, *f_cos);
     return 1;
@@ -903,7 +1105,7 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
 {
     vec wi, Le, f;
     real dist, pdf, cosi;
-    int l = choose_light(s, random01(wk)), delta;
+    int l = choose_light(s, bounce_random(wk, LIGHT_CHOICE)), delta;
     Ray r;
     if (l < 0) return v3(0, 0, 0);
     delta = sample_emitter(s, l, h->p, b->n, wk, &wi, &dist, &Le, &pdf);
@@ -1013,7 +1215,7 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *
 {
     const Emitter *e = &s->emit[l];
     const Material *m;
-    real u = random01(wk), v = random01(wk);
+    real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V);
     vec y, ny;
     int k;
     *pdf = 0;
@@ -1026,10 +1228,10 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *
         return 1;
     }
     if (e->type == SKY_LIGHT) {
-        *wi = cosine_direction(n, u, v);
+        *wi = from_local(n, cosine_hemisphere(u, v));
         *dist = INFINITY;
         *Le = s->background;
-        *pdf = dot(*wi, n) / (real)PI;
+        *pdf = cosine_hemisphere_pdf(dot(*wi, n));
         return 0;
     }
     kind(s, e->obj, &k);
@@ -1057,7 +1259,7 @@ static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny)
     vec d;
     real dist;
     int k;
-    if (e->type == SKY_LIGHT) return light_choice(s, l) * fmax(0, dot(y, n)) / (real)PI;
+    if (e->type == SKY_LIGHT) return light_choice(s, l) * cosine_hemisphere_pdf(dot(y, n));
     kind(s, e->obj, &k);
     if (e->type == SPHERE_LIGHT) return light_choice(s, l) * sphere_pdf(&s->sph[k], x, y);
     d = sub(y, x);
@@ -1122,11 +1324,10 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
 {
     real cosi = dot(wi, b->n), pdf;
     if (!(cosi > 0 && dot(wi, b->ng) > 0)) return 0;
-    pdf = b->p[DIFFUSE_LOBE] * cosi / (real)PI;
-    if (b->glossy > 0) {
-        real c = fmax(0, dot(wi, reflect(scale(-1, wo), b->n, dot(wo, b->n))));
-        pdf += b->p[GLOSSY_LOBE] * (b->shine + 1) / (2 * (real)PI) * pow(c, b->shine);
-    }
+    pdf = b->p[DIFFUSE_LOBE] * cosine_hemisphere_pdf(cosi);
+    if (b->glossy > 0)
+        pdf += b->p[GLOSSY_LOBE]
+               * phong_lobe_pdf(b->shine, dot(wi, reflect(scale(-1, wo), b->n, dot(wo, b->n))));
     return pdf;
 }
 
@@ -1137,7 +1338,8 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
  * light is absorbed, or the direction fell below the surface). */
 static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf)
 {
-    real u = random01(wk), u1 = random01(wk), u2 = random01(wk), cosi = dot(wo, b->n);
+    real u = bounce_random(wk, LOBE), cosi = dot(wo, b->n);
+    real u1 = bounce_random(wk, DIRECTION_U), u2 = bounce_random(wk, DIRECTION_V);
     int lobe = 0;
     *pdf = 0;
     while (lobe < GLASS_LOBE && u >= b->p[lobe]) u -= b->p[lobe++];
@@ -1148,10 +1350,10 @@ static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, r
         return dot(*wi, b->ng) > 0 ? lobe : -1;
     }
     if (lobe == GLASS_LOBE) return sample_glass(b, wo, u / b->p[lobe], wi, f_cos);
-    if (lobe == DIFFUSE_LOBE) *wi = cosine_direction(b->n, u1, u2);
-    else *wi = phong_direction(reflect(scale(-1, wo), b->n, cosi), b->shine, u1, u2);
+    if (lobe == DIFFUSE_LOBE) *wi = from_local(b->n, cosine_hemisphere(u1, u2));
+    else *wi = from_local(reflect(scale(-1, wo), b->n, cosi), phong_lobe(b->shine, u1, u2));
     if (b->glossy == 0) {         /* Lambert alone: f cos / pdf is the albedo over its chance */
-        *pdf = b->p[DIFFUSE_LOBE] * dot(*wi, b->n) / (real)PI;
+        *pdf = b->p[DIFFUSE_LOBE] * cosine_hemisphere_pdf(dot(*wi, b->n));
         *f_cos = scale(1 / b->p[DIFFUSE_LOBE], b->albedo);
         return dot(*wi, b->ng) > 0 && *pdf > 0 ? lobe : -1;
     }
@@ -1166,7 +1368,11 @@ static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, r
  * chance, so the weight is the lobe's alone, times eta^2 through the
  * surface: radiance is crowded into a narrower cone entering a denser
  * medium, and spreads out leaving it (the same factor, inverted, so a
- * path in and out again gets the two back to 1). */
+ * path in and out again gets the two back to 1).  u is what is left of the
+ * number that chose the lobe, rescaled to [0, 1): given that glass was
+ * chosen, it is again uniform and tells nothing of the choice, so it can
+ * choose once more, and the choice needs no dimension of its own (the
+ * LOBE slot serves both; SPARE stays free). */
 static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos)
 {
     real cosi = dot(wo, b->n), w = b->glass / b->p[GLASS_LOBE];
@@ -1196,64 +1402,6 @@ static real fresnel(real cosi, real eta)
     rs = (eta * cosi - cost) / (eta * cosi + cost);
     rp = (cosi - eta * cost) / (cosi + eta * cost);
     return (rs * rs + rp * rp) / 2;
-}
-
-/* A direction about the unit vector n with pdf cos(theta)/pi (Malley's
- * method: a uniform point of the unit disc, lifted onto the hemisphere). */
-static vec cosine_direction(vec n, real u1, real u2)
-{
-    real r = sqrt(u1), phi = 2 * (real)PI * u2;
-    return from_local(n, r * cos(phi), r * sin(phi), sqrt(fmax(0, 1 - u1)));
-}
-
-/* A direction about the unit vector m with pdf (shine+1)/(2 pi) cos^shine
- * of the angle to m: the lobe of the modified Phong BRDF (Lafortune and
- * Willems, "Using the modified Phong reflectance model for physically based
- * rendering", 1994). */
-static vec phong_direction(vec m, real shine, real u1, real u2)
-{
-    real c = pow(u1, 1 / (shine + 1)), s = sqrt(fmax(0, 1 - c * c)), phi = 2 * (real)PI * u2;
-    return from_local(m, s * cos(phi), s * sin(phi), c);
-}
-
-/* x t1 + y t2 + z n for an orthonormal t1, t2 made from the unit vector n
- * (Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017). */
-static vec from_local(vec n, real x, real y, real z)
-{
-    real sign = n.z >= 0 ? 1 : -1, a = -1 / (sign + n.z), b = n.x * n.y * a;
-    vec t1 = v3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    vec t2 = v3(b, sign + n.y * n.y * a, -n.y);
-    return add(add(scale(x, t1), scale(y, t2)), scale(z, n));
-}
-
-/* Random numbers without a generator's state: the n-th number of sample k
- * of pixel p is a hash of (seed, p, k, n).  So a pixel's noise does not
- * depend on which thread computes it, nor on the order, and any part of an
- * image can be rendered apart and put together exactly.  (smallpt seeds a
- * generator per row with y^3 cut to 16 bits, which gives rows 0, 64,
- * 128, ... the same noise.)  The hash is the finaliser of SplitMix64
- * (Steele, Lea and Flood, "Fast splittable pseudorandom number generators",
- * OOPSLA 2014), applied once per key and once per number. */
-static unsigned long long mix64(unsigned long long z)
-{
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-}
-
-static void start_sample(Worker *wk, const Scene *s, int i, int j, int k)
-{
-    unsigned long long pixel = (unsigned long long)j * (unsigned)s->w + (unsigned)i;
-    wk->key = mix64(mix64(mix64(s->seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
-    wk->dim = 0;
-}
-
-/* The next random number of the sample, uniform in [0, 1). */
-static real random01(Worker *wk)
-{
-    unsigned long long h = mix64(wk->key + 0x9e3779b97f4a7c15ULL * ++wk->dim);
-    real u = (real)((h >> 11) * (1.0 / 9007199254740992.0));
-    return u < 1 ? u : 1 - REAL_EPS;      /* a float may round up to 1 */
 }
 
 /* ------------------------------------------------------------ finding hits */
@@ -1720,20 +1868,17 @@ static int sphere_clip(const Sphere *sp, const double blo[3], const double bhi[3
 static real sphere_sample(const Sphere *sp, vec x, real u, real v, vec *wi, real *dist)
 {
     vec dc = sub(sp->cen, x), n;
-    real d2 = dot(dc, dc), r2 = sp->rad * sp->rad, z, rr, phi;
+    real d2 = dot(dc, dc), r2 = sp->rad * sp->rad;
     if (d2 > r2 * (1 + 64 * REAL_EPS)) {
         real d = sqrt(d2), sin2max = r2 / d2;
         real cap = sin2max / (1 + sqrt(1 - sin2max));     /* 1 - cos(theta_max), no cancelling */
-        real c = 1 - u * cap, s2 = fmax(0, 1 - c * c);
-        phi = 2 * (real)PI * v;
-        *wi = from_local(scale(1 / d, dc), sqrt(s2) * cos(phi), sqrt(s2) * sin(phi), c);
+        vec l = sphere_cap(cap, u, v);                    /* about the direction to the centre */
+        real c = l.z, s2 = fmax(0, 1 - c * c);
+        *wi = from_local(scale(1 / d, dc), l);
         *dist = d * c - sqrt(fmax(0, r2 - d2 * s2));
-        return 1 / (2 * (real)PI * cap);
+        return sphere_cap_pdf(cap);
     }
-    z = 1 - 2 * u;
-    rr = sqrt(fmax(0, 1 - z * z));
-    phi = 2 * (real)PI * v;
-    n = v3(rr * cos(phi), rr * sin(phi), z);
+    n = sphere_cap(2, u, v);                    /* a uniform point of the whole sphere */
     dc = sub(comb(sp->rad, n, sp->cen), x);
     *dist = sqrt(dot(dc, dc));
     *wi = scale(1 / *dist, dc);
@@ -1747,7 +1892,7 @@ static real sphere_pdf(const Sphere *sp, vec x, vec y)
     vec dc = sub(sp->cen, x), d = sub(y, x);
     real d2 = dot(dc, dc), r2 = sp->rad * sp->rad, dist2 = dot(d, d), cosy;
     if (d2 > r2 * (1 + 64 * REAL_EPS))
-        return 1 / (2 * (real)PI * (r2 / d2 / (1 + sqrt(1 - r2 / d2))));
+        return sphere_cap_pdf(r2 / d2 / (1 + sqrt(1 - r2 / d2)));
     cosy = fabs(dot(sub(y, sp->cen), d)) / (sp->rad * sqrt(dist2));
     return dist2 / (4 * (real)PI * r2 * cosy);
 }
@@ -2088,12 +2233,12 @@ static int triangle_clip(const Scene *s, const Triangle *tr, const double blo[3]
     return 1;
 }
 
-/* For a triangle that emits: a uniform point y of it, and its front normal
- * (Turk, "Generating random points in triangles", Graphics Gems, 1990). */
+/* For a triangle that emits: a uniform point y of it (uniform_triangle),
+ * and its front normal. */
 static void triangle_sample(const Triangle *tr, real u, real v, vec *y, vec *ny)
 {
-    real su = sqrt(u);
-    *y = add(tr->v0, add(scale(su * (1 - v), tr->e1), scale(su * v, tr->e2)));
+    vec b = uniform_triangle(u, v);
+    *y = add(tr->v0, add(scale(b.y, tr->e1), scale(b.z, tr->e2)));
     *ny = unit(cross(tr->e1, tr->e2));
 }
 
@@ -2103,7 +2248,7 @@ static void triangle_sample(const Triangle *tr, real u, real v, vec *y, vec *ny)
 static real triangle_pdf(const Triangle *tr, real dist, real cosy)
 {
     vec n = cross(tr->e1, tr->e2);
-    return dist * dist / (sqrt(dot(n, n)) / 2 * fabs(cosy));
+    return uniform_triangle_pdf(sqrt(dot(n, n)) / 2) * dist * dist / fabs(cosy);
 }
 
 /* Zero area (a repeated vertex, or three in a line) to within rounding: such

@@ -55,6 +55,25 @@ static Worker worker(void)
     return wk;
 }
 
+/* The tests' own random numbers, one after another: the n-th is a hash of
+ * (seed, n).  The renderer draws each of its numbers from a named slot
+ * instead (ray.c's samples section); a test that only needs many
+ * independent numbers takes them in turn from here. */
+typedef struct { unsigned long long key, n; } Sequence;
+
+static Sequence sequence(unsigned long long seed)
+{
+    Sequence q;
+    q.key = mix64(seed ^ 0x5851f42d4c957f2dULL);
+    q.n = 0;
+    return q;
+}
+
+static double next01(Sequence *q)
+{
+    return (double)(mix64(q->key + 0x9e3779b97f4a7c15ULL * ++q->n) >> 11) * (1.0 / 9007199254740992.0);
+}
+
 static int material(Scene *s, vec color, double kd, double ks, double kt, double kl, double ir,
                     double shine)
 {
@@ -198,8 +217,8 @@ static void test_sphere_is_point(void)
             Ray ry;
             vec p, d, L;
             double want;
-            start_sample(&wk, &s, k, 1, 0);
-            p = v3(4 * random01(&wk) - 2, 4 * random01(&wk) - 2, 0);
+            start_sample(&wk, &s, k, 1, 0);     /* the point takes the pixel's dimensions */
+            p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
             ry.o = v3(p.x, p.y, 1);             /* below the light, above the floor */
             ry.d = v3(0, 0, -1);
             ry.tmin = 0, ry.skip = -1;
@@ -314,12 +333,11 @@ static void test_reciprocity(void)
     int l, k;
     char name[96];
     for (l = 0; l < NLOBES; l++) {
-        Worker wk = worker();
+        Sequence q = sequence(l);
         double worst = 0;
-        start_sample(&wk, &(Scene){ 0 }, l, 0, 0);
         for (k = 0; k < 100000; k++) {
-            vec a = polar(acos(random01(&wk)), 2 * PI * random01(&wk));
-            vec b = polar(acos(random01(&wk)), 2 * PI * random01(&wk));
+            vec a = polar(acos(next01(&q)), 2 * PI * next01(&q));
+            vec b = polar(acos(next01(&q)), 2 * PI * next01(&q));
             Bsdf ba = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, a);
             Bsdf bb = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, b);
             vec f1 = bsdf_eval(&ba, a, b), f2 = bsdf_eval(&bb, b, a);
@@ -347,15 +365,19 @@ static void test_energy(void)
             Bsdf b = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, wo);
             Worker wk = worker();
             Stat own = { 0, 0, 0 }, uni = { 0, 0, 0 };
+            Scene z = { 0 };
+            Sequence q = sequence(16 * l + a);
             double head;
-            start_sample(&wk, &(Scene){ 0 }, l, a, 1);
+            z.w = 8;                        /* pixels (l, a) apart: their own samples */
             for (k = 0; k < 200000; k++) {
                 vec wi, f_cos, wu, f;
                 real pdf;
                 double m;
-                int lobe = sample_bsdf(&b, wo, &wk, &wi, &f_cos, &pdf);
+                int lobe;
+                start_sample(&wk, &z, l, a, k);
+                lobe = sample_bsdf(&b, wo, &wk, &wi, &f_cos, &pdf);
                 stat_add(&own, lobe < 0 ? 0 : fmax(f_cos.x, fmax(f_cos.y, f_cos.z)));
-                wu = polar(acos(random01(&wk)), 2 * PI * random01(&wk));
+                wu = polar(acos(next01(&q)), 2 * PI * next01(&q));
                 f = bsdf_eval(&b, wo, wu);
                 m = fmax(f.x, fmax(f.y, f.z));
                 stat_add(&uni, m * wu.z * 2 * PI);
@@ -426,6 +448,28 @@ static double cell_integral(const Bsdf *b, vec wo, double t0, double t1, double 
     return sum * (t1 - t0) / 8 * (p1 - p0) / 8;
 }
 
+/* Pearson's statistic (Pearson 1900) of observed against expected counts
+ * in n cells, the cells expecting fewer than 5 pooled into one (which
+ * counts as expecting at least 5); in *chi2 and *dof, and returned its
+ * p-value, the chance that a correct sampler gives a statistic as large. */
+static double pearson(const double *observed, const double *expected, int n, double *chi2, int *dof)
+{
+    double pool_o = 0, pool_e = 0;
+    int k;
+    *chi2 = 0;
+    *dof = 0;
+    for (k = 0; k < n; k++) {
+        if (expected[k] < 5) { pool_o += observed[k]; pool_e += expected[k]; continue; }
+        *chi2 += (observed[k] - expected[k]) * (observed[k] - expected[k]) / expected[k];
+        ++*dof;
+    }
+    if (pool_e > 0) {
+        *chi2 += (pool_o - pool_e) * (pool_o - pool_e) / fmax(pool_e, 5);
+        ++*dof;
+    }
+    return gamma_q((*dof - 1) / 2.0, *chi2 / 2);
+}
+
 #define NT 80
 #define NP 160
 #define CHI_SAMPLES 1000000
@@ -449,13 +493,16 @@ static void test_chi2(void)
             vec wo = polar(angles[a] * PI / 180, 1.1);
             Bsdf b = plane_bsdf(lobes[l].albedo, lobes[l].glossy, lobes[l].shine, wo);
             Worker wk = worker();
-            double chi2 = 0, pool_o = 0, pool_e = 0, inside = 0, p;
-            int i, j, k, dof = 0;
+            Scene z = { 0 };
+            double chi2, inside = 0, p;
+            int i, j, k, dof;
             memset(observed, 0, sizeof observed);
-            start_sample(&wk, &(Scene){ 0 }, l, a, 2);
+            z.w = 8;
+            z.seed = 2;
             for (k = 0; k < CHI_SAMPLES; k++) {
                 vec wi, f_cos;
                 real pdf;
+                start_sample(&wk, &z, l, a, k);
                 if (sample_bsdf(&b, wo, &wk, &wi, &f_cos, &pdf) < 0) { observed[NT * NP]++; continue; }
                 i = (int)(acos(fmax(-1, fmin(1, wi.z))) / PI * NT);
                 j = (int)((atan2(wi.y, wi.x) + PI) / (2 * PI) * NP);
@@ -469,20 +516,221 @@ static void test_chi2(void)
                     inside += e;
                 }
             expected[NT * NP] = CHI_SAMPLES - inside;
-            for (k = 0; k <= NT * NP; k++) {
-                if (expected[k] < 5) { pool_o += observed[k]; pool_e += expected[k]; continue; }
-                chi2 += (observed[k] - expected[k]) * (observed[k] - expected[k]) / expected[k];
-                dof++;
-            }
-            if (pool_e > 0) {
-                chi2 += (pool_o - pool_e) * (pool_o - pool_e) / fmax(pool_e, 5);
-                dof++;
-            }
-            p = gamma_q((dof - 1) / 2.0, chi2 / 2);
+            p = pearson(observed, expected, NT * NP + 1, &chi2, &dof);
             sprintf(name, "%s from %g degrees: chi-square, sampling matches the pdf", lobes[l].name,
                     angles[a]);
             report(p > alpha, name, "chi2 %.0f, %d cells, p = %.3g", chi2, dof, p);
         }
+}
+
+/* ---- the warps ---- */
+
+/* Each warp of ray.c's samples section against its own pdf, as test_chi2
+ * holds the BSDFs to theirs.  The directions (cosine_hemisphere,
+ * phong_lobe about z, sphere_cap) are counted in cells of theta x phi up
+ * to the warp's largest theta, uniform_disc's points in cells of r x phi
+ * (a grid its concentric squares do not follow), and a triangle's
+ * barycentrics (b1, b2) in the 2 N^2 small triangles of its N-fold
+ * subdivision; one more cell takes any point outside the domain. */
+enum { COSINE, PHONG, CAP, TRIANGLE_WARP, DISC };
+typedef struct { const char *name; int kind; double param; } Warp;   /* param: shine, or degrees */
+
+static const Warp warps[] = {
+    { "cosine_hemisphere", COSINE, 0 },
+    { "phong_lobe, shine 1", PHONG, 1 },
+    { "phong_lobe, shine 10", PHONG, 10 },
+    { "phong_lobe, shine 200", PHONG, 200 },
+    { "sphere_cap, 20 degrees", CAP, 20 },
+    { "sphere_cap, 100 degrees", CAP, 100 },
+    { "sphere_cap, the whole sphere", CAP, 180 },
+    { "uniform_triangle", TRIANGLE_WARP, 0 },
+    { "uniform_disc", DISC, 0 },
+};
+#define NWARPS ((int)(sizeof warps / sizeof warps[0]))
+#define WT 48               /* cells in theta or r */
+#define WP 96               /* cells in phi */
+#define WN 24               /* the triangle's subdivision */
+#define WARP_SAMPLES 200000
+
+static double theta_max(const Warp *w)
+{
+    return w->kind == CAP ? w->param * PI / 180 : PI / 2;
+}
+
+/* The cap of the cone: 1 - cos(theta_max). */
+static double cap_of(const Warp *w) { return 1 - cos(theta_max(w)); }
+
+static vec warp(const Warp *w, real u1, real u2)
+{
+    switch (w->kind) {
+    case COSINE: return cosine_hemisphere(u1, u2);
+    case PHONG: return phong_lobe((real)w->param, u1, u2);
+    case CAP: return sphere_cap((real)cap_of(w), u1, u2);
+    case DISC: return uniform_disc(u1, u2);
+    }
+    return uniform_triangle(u1, u2);
+}
+
+/* The pdf at a point of the domain: in solid angle for a direction d, in
+ * area for a point of the disc, and in area of the (b1, b2) plane, where
+ * the triangle has area 1/2, for barycentrics. */
+static double warp_pdf(const Warp *w, vec d)
+{
+    switch (w->kind) {
+    case COSINE: return cosine_hemisphere_pdf(d.z);
+    case PHONG: return phong_lobe_pdf((real)w->param, d.z);
+    case CAP: return sphere_cap_pdf((real)cap_of(w));
+    case DISC: return uniform_disc_pdf();
+    }
+    return uniform_triangle_pdf((real)0.5);
+}
+
+static int ncells(const Warp *w) { return w->kind == TRIANGLE_WARP ? 2 * WN * WN : WT * WP; }
+
+/* The cell of a point, or ncells for one outside the domain. */
+static int warp_cell(const Warp *w, vec p)
+{
+    int i, j;
+    if (w->kind == TRIANGLE_WARP) {
+        double x = p.y * WN, y = p.z * WN;
+        i = (int)floor(x), j = (int)floor(y);
+        if (!(p.y >= 0 && p.z >= 0 && p.y + p.z <= 1) || i >= WN || j >= WN) return ncells(w);
+        return 2 * (i * WN + j) + (x - i + (y - j) > 1);
+    }
+    i = w->kind == DISC ? (int)(sqrt(p.x * p.x + p.y * p.y) * WT)
+                        : (int)(acos(fmax(-1, fmin(1, p.z))) / theta_max(w) * WT);
+    j = (int)((atan2(p.y, p.x) + PI) / (2 * PI) * WP);
+    if (i >= WT) return ncells(w);
+    return i * WP + (j < WP ? j : WP - 1);
+}
+
+/* The pdf integrated over cell k: a direction's by the midpoint rule on an
+ * 8 x 8 grid of the cell (solid angle sin(theta) dtheta dphi, as
+ * cell_integral), the disc's alike (area r dr dphi); a small triangle's by
+ * its centroid (the midpoint rule of a triangle) times its area
+ * 1 / (2 N^2). */
+static double warp_mass(const Warp *w, int k)
+{
+    double sum = 0, t0, t1, p0, p1;
+    int a, b;
+    if (w->kind == TRIANGLE_WARP) {
+        int i = k / 2 / WN, j = k / 2 % WN, upper = k % 2;
+        double x = (i + (upper ? 2 : 1) / 3.0) / WN, y = (j + (upper ? 2 : 1) / 3.0) / WN;
+        return x + y <= 1 ? warp_pdf(w, v3(1 - x - y, x, y)) / (2.0 * WN * WN) : 0;
+    }
+    if (w->kind == DISC) {
+        t0 = (double)(k / WP) / WT, t1 = (double)(k / WP + 1) / WT;  /* r */
+        for (a = 0; a < 8; a++) {
+            double r = t0 + (t1 - t0) * (a + 0.5) / 8;
+            sum += uniform_disc_pdf() * r;          /* constant in phi */
+        }
+        return sum * (t1 - t0) / 8 * (2 * PI / WP);
+    }
+    t0 = theta_max(w) * (k / WP) / WT, t1 = theta_max(w) * (k / WP + 1) / WT;
+    p0 = 2 * PI * (k % WP) / WP - PI, p1 = 2 * PI * (k % WP + 1) / WP - PI;
+    for (a = 0; a < 8; a++)
+        for (b = 0; b < 8; b++) {
+            double t = t0 + (t1 - t0) * (a + 0.5) / 8, p = p0 + (p1 - p0) * (b + 0.5) / 8;
+            sum += warp_pdf(w, polar(t, p)) * sin(t);
+        }
+    return sum * (t1 - t0) / 8 * (p1 - p0) / 8;
+}
+
+/* For each warp: Pearson's chi-square of 200000 points against the counts
+ * its pdf expects in each cell (the significance 0.01 shared among the
+ * warps by Sidak's correction, as test_chi2), and the pdf's integral over
+ * the domain, the sum of the cells' masses, is 1 to within 1e-3 (the
+ * quadrature's error is far smaller: a pdf 1.005 times too large, Phong
+ * 200's with shine + 2 for shine + 1, is caught here and not by the
+ * chi-square). */
+static void test_warps(void)
+{
+    static double observed[2 * WN * WN > WT * WP ? 2 * WN * WN + 1 : WT * WP + 1];
+    static double expected[sizeof observed / sizeof observed[0]];
+    double alpha = 1 - pow(1 - 0.01, 1.0 / NWARPS);
+    char name[128];
+    int l;
+    for (l = 0; l < NWARPS; l++) {
+        const Warp *w = &warps[l];
+        Sequence q = sequence(100 + l);
+        double chi2, total = 0, p;
+        int k, n = ncells(w), dof;
+        memset(observed, 0, sizeof observed);
+        for (k = 0; k < WARP_SAMPLES; k++) {
+            real u1 = (real)next01(&q), u2 = (real)next01(&q);
+            observed[warp_cell(w, warp(w, u1, u2))]++;
+        }
+        for (k = 0; k < n; k++) total += (expected[k] = warp_mass(w, k));
+        for (k = 0; k < n; k++) expected[k] *= WARP_SAMPLES;
+        expected[n] = fmax(0, WARP_SAMPLES * (1 - total));
+        p = pearson(observed, expected, n + 1, &chi2, &dof);
+        sprintf(name, "warp %s: chi-square, its points match its pdf", w->name);
+        report(p > alpha, name, "chi2 %.0f, %d cells, p = %.3g", chi2, dof, p);
+        sprintf(name, "warp %s: its pdf integrates to 1", w->name);
+        report(fabs(total - 1) < 1e-3, name, "%.6f by the midpoint rule", total);
+    }
+}
+
+/* ---- the dimensions ---- */
+
+/* Each named dimension is a number of its own: for 1000 samples, the
+ * numbers of the pixel's, the lens's and the time's dimensions and of
+ * every named slot of the first four bounces' blocks are all different.
+ * Two names given one slot, a slot past its block (into the next bounce's)
+ * or a block over the camera's dimensions would make two of them equal. */
+static void test_dimensions_distinct(void)
+{
+    static const int camera[] = { DIM_PIXEL_X, DIM_PIXEL_Y, DIM_LENS_U, DIM_LENS_V, DIM_TIME };
+    static const int slot[] = { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE, SPARE };
+    enum { NC = sizeof camera / sizeof camera[0], NS = sizeof slot / sizeof slot[0], BOUNCES = 4 };
+    Worker wk = worker();
+    Scene z = { 0 };
+    int k, d, e, same = 0;
+    z.w = 1000;
+    for (k = 0; k < 1000; k++) {
+        real u[NC + BOUNCES * NS];
+        start_sample(&wk, &z, k, 3, 5);
+        for (d = 0; d < NC; d++) u[d] = random01(&wk, camera[d]);
+        for (wk.bounce = 0; wk.bounce < BOUNCES; wk.bounce++)
+            for (d = 0; d < NS; d++) u[NC + wk.bounce * NS + d] = bounce_random(&wk, slot[d]);
+        for (d = 0; d < NC + BOUNCES * NS; d++)
+            for (e = d + 1; e < NC + BOUNCES * NS; e++) same += u[d] == u[e];
+    }
+    report(same == 0, "dimensions: the pixel's, the lens's, the time's and 4 bounces' named slots are distinct numbers",
+           "%d equal pairs in 1000 samples", same);
+}
+
+/* The numbers are drawn by dimension, not in turn: nee and mis draw a
+ * light at every bounce and bsdf does not, yet the BSDF's and roulette's
+ * numbers are the same, so each path takes the same turns whatever the
+ * estimator (the light it gathers differs, its way does not).  The same
+ * number of rays bounce, and as many nearest-hit queries are made, in a
+ * Cornell box of 32 x 32 pixels, 4 paths each. */
+static void test_dimensions_fixed(void)
+{
+    unsigned long long bounced[3], nearest[3];
+    int e;
+    for (e = 0; e < 3; e++) {
+        Scene s;
+        Worker wk = worker();
+        int i, j;
+        if (!load_scene(&s, "scenes/cornell.sph")) {
+            report(0, "dimensions: the paths are the same for every estimator", "cannot load scenes/cornell.sph");
+            return;
+        }
+        s.w = s.h = 32;
+        ready(&s, e, 1, 0);
+        for (j = 0; j < s.h; j++)
+            for (i = 0; i < s.w; i++) pixel_radiance(&s, i, j, 4, &wk);
+        bounced[e] = wk.count.bounced;
+        nearest[e] = wk.count.nearest;
+        free_scene(&s);
+    }
+    report(bounced[0] == bounced[1] && bounced[1] == bounced[2] && nearest[0] == nearest[1]
+               && nearest[1] == nearest[2],
+           "dimensions: bsdf, nee and mis trace the same paths (a light drawn or not moves no other number)",
+           "bounced %llu %llu %llu, nearest-hit queries %llu %llu %llu", bounced[0], bounced[1], bounced[2],
+           nearest[0], nearest[1], nearest[2]);
 }
 
 /* Fresnel's equations at known points: ((n-1)/(n+1))^2 head on, 1 past the
@@ -607,6 +855,9 @@ int main(void)
     test_reciprocity();
     test_energy();
     test_chi2();
+    test_warps();
+    test_dimensions_distinct();
+    test_dimensions_fixed();
     test_furnace();
     test_point_in_sphere();
     test_sphere_is_point();
