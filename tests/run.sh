@@ -1,19 +1,37 @@
 #!/usr/bin/env bash
 # The test driver behind `make test`.
-# Every tests/*.test.sh is run in turn from the repository root.  A test script
+# Every tests/*.test.sh is run from the repository root.  A test script
 # prints one line per check, starting with "PASS " or "FAIL ".  A script that
 # exits non-zero without printing a FAIL line counts as one failure, so a
 # crash can never look like success.  The last line is "N passed, N failed".
 cd "$(dirname "$0")/.." || exit 2
+# The scripts run side by side, TEST_JOBS at a time (default: one per
+# core), the longest first; their lines are printed in the scripts' own
+# order when all are done, so the output does not depend on the timing.
+jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
+out=$(mktemp -d "${TMPDIR:-/tmp}/testrun.XXXXXX")
+trap 'rm -rf "$out"' EXIT
+longest_first="tests/accel.test.sh tests/ray.test.sh"
+scripts=$longest_first
+for t in tests/*.test.sh; do
+  case " $longest_first " in *" $t "*) ;; *) scripts="$scripts $t";; esac
+done
+for t in $scripts; do
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n 2>/dev/null || sleep 0.1; done
+  n=$(basename "$t" .test.sh)
+  ( bash "$t" >"$out/$n.out" 2>&1; echo $? >"$out/$n.rc" ) &
+done
+wait
 pass=0 fail=0
 for t in tests/*.test.sh; do
-  out=$(bash "$t" 2>&1); rc=$?
-  printf '%s\n' "$out" | grep -E '^(PASS|FAIL) ' | sed "s|^|$(basename "$t" .test.sh): |"
-  p=$(printf '%s\n' "$out" | grep -c '^PASS ')
-  f=$(printf '%s\n' "$out" | grep -c '^FAIL ')
+  n=$(basename "$t" .test.sh)
+  rc=$(cat "$out/$n.rc")
+  grep -E '^(PASS|FAIL) ' "$out/$n.out" | sed "s|^|$n: |"
+  p=$(grep -c '^PASS ' "$out/$n.out")
+  f=$(grep -c '^FAIL ' "$out/$n.out")
   if [ "$rc" != 0 ] && [ "$f" = 0 ]; then
-    echo "$(basename "$t" .test.sh): FAIL script exited $rc; its last lines:"
-    printf '%s\n' "$out" | tail -n 5 | sed 's/^/    /'
+    echo "$n: FAIL script exited $rc; its last lines:"
+    tail -n 5 "$out/$n.out" | sed 's/^/    /'
     f=1
   fi
   pass=$((pass + p)) fail=$((fail + f))
