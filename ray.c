@@ -182,6 +182,44 @@ typedef struct {
     vec pos, intensity;       /* a point light's place and intensity I (radiance: I / d^2) */
 } Emitter;
 
+/* A Scene holds four things, each of its own: what the file describes
+ * (the objects, the camera, the lights as Whitted sees them), the render's
+ * settings (from the file and the command line), the path tracer's lights
+ * (made by prepare_lights), and the structure that finds hits (made by
+ * build_accel). */
+
+/* The render's settings. */
+typedef struct {
+    int w, h;                 /* the image, in pixels */
+    int integrator;           /* WHITTED or PATH */
+    int depth;                /* Whitted: the recursion's depth */
+    int max_rays;             /* path tracing: rays on a path at most (-d); 0: no bound but roulette */
+    int spp;                  /* samples per pixel the scene asks for (0: none said) */
+    int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
+    int roulette;             /* 1: Russian roulette ends paths */
+    unsigned seed;            /* --seed: which noise */
+    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, or 0 */
+    real far;                 /* --view depth: the farthest point of the scene from the eye */
+    const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
+} Settings;
+
+/* The path tracer's lights, each chosen in proportion to its power. */
+typedef struct {
+    Emitter *emit;  int nemit;
+    int sky;                  /* the sky's light, or -1 */
+    real *emit_cdf;           /* emit_cdf[i]: chance of choosing one of lights 0..i */
+    int *emitter;             /* emitter[object]: its light, or -1 */
+} Lights;
+
+/* The structure that finds hits. */
+typedef struct {
+    int which;                /* an ACCEL_ below */
+    kd_tree *kd;              /* the kd-tree, when which is ACCEL_KD */
+    bvh *bvh;                 /* the BVH, when ACCEL_BVH */
+    grid *grid;               /* the grid, when ACCEL_GRID */
+    prims prims;              /* how the structure sees the objects (prims.h) */
+} Structure;
+
 typedef struct {
     Material *mat;  int nmat, capmat;
     Sphere *sph;    int nsph, capsph;
@@ -191,30 +229,14 @@ typedef struct {
     vec *norm;      int nnorm, capnorm;
     Light *light;   int nlight, caplight;
     Camera cam;
-    int w, h, depth;
     vec ambient, background;
-    int cull;                 /* for triangles still to come: `sided 1` */
-    int integrator;           /* WHITTED or PATH */
-    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, or 0 */
-    real far;                 /* --view depth: the farthest point of the scene from the eye */
-    int spp;                  /* samples per pixel the scene asks for (0: none said) */
-    int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
-    int roulette;             /* 1: Russian roulette ends paths */
     int tir_reflect;          /* Whitted: past the critical angle kt goes to the mirror */
-    int max_rays;             /* rays on a path at most (-d); 0: no bound but roulette */
-    unsigned seed;            /* --seed: which noise */
-    Emitter *emit;  int nemit;  /* the path tracer's lights */
-    int sky;                  /* the sky's light, or -1 */
-    real *emit_cdf;           /* emit_cdf[i]: chance of choosing one of lights 0..i */
-    int *emitter;             /* emitter[object]: its light, or -1 */
+    int cull;                 /* while reading: `sided 1` for the triangles still to come */
     char warning[256];        /* said once when the path tracer starts, if set */
     char whitted_warning[256];  /* the same for Whitted's */
-    int accel;                /* which structure finds hits: an ACCEL_ below */
-    const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
-    kd_tree *kd;              /* the kd-tree, when accel is ACCEL_KD */
-    bvh *bvh;                 /* the BVH, when accel is ACCEL_BVH */
-    grid *grid;               /* the grid, when accel is ACCEL_GRID */
-    prims prims;              /* how the structure sees the objects (prims.h) */
+    Settings set;
+    Lights lights;
+    Structure accel;
 } Scene;
 
 /* --accel none: every ray tests every object; kd: the kd-tree of kdtree.c;
@@ -460,9 +482,9 @@ static real triangle_pdf(const Triangle *tr, real dist, real cosy);
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 {
     int i;
-    for (i = 0; i < s->w; i++)
-        put_pixel(img, i, j, s->view ? pixel_view(s, i, j, wk)      /* --view: see the plumbing */
-                             : s->integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
+    for (i = 0; i < s->set.w; i++)
+        put_pixel(img, i, j, s->set.view ? pixel_view(s, i, j, wk)      /* --view: see the plumbing */
+                             : s->set.integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
                              : pixel_color(s, i, j, spp, wk));
 }
 
@@ -477,7 +499,7 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
         sample_offset(k, s->cam.anchor, &dx, &dy);
         wk->count.primary++;
         wk->budget = RAY_BUDGET;
-        sum = add(sum, trace(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), s->depth, 1, wk));
+        sum = add(sum, trace(s, camera_ray(&s->cam, s->set.w, s->set.h, i + dx, j + dy), s->set.depth, 1, wk));
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
     return scale((real)1 / spp, sum);
@@ -667,8 +689,8 @@ enum { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE,
  * its path at the first hit. */
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k)
 {
-    unsigned long long pixel = (unsigned long long)j * (unsigned)s->w + (unsigned)i;
-    wk->key = mix64(mix64(mix64(s->seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
+    unsigned long long pixel = (unsigned long long)j * (unsigned)s->set.w + (unsigned)i;
+    wk->key = mix64(mix64(mix64(s->set.seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
     wk->bounce = 0;
 }
 
@@ -1008,7 +1030,7 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     path.beta = v3(1, 1, 1);
     path.rays = 1;
     path.counted = 1;
-    return radiance(s, camera_ray(&s->cam, s->w, s->h, i + dx, j + dy), &path, wk);
+    return radiance(s, camera_ray(&s->cam, s->set.w, s->set.h, i + dx, j + dy), &path, wk);
 }
 
 /* L(x, wo) = Le(x, wo) + integral f Li cos, for the ray r arriving at x:
@@ -1023,12 +1045,12 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
     int lobe;
     if (!nearest_hit(s, r, &h, wk)) return sky(s, r.d, path);
     Le = emitted(s, &h, wo, path);
-    if (path->rays == s->max_rays || path->rays == MAX_PATH) return Le;
+    if (path->rays == s->set.max_rays || path->rays == MAX_PATH) return Le;
     bsdf_at(s, &h, wo, &b);
     /* this hit's block of random numbers; the next hit sets its own, and
      * nothing below draws after radiance() of the next ray returns */
     wk->bounce = path->rays - 1;
-    direct = s->estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
+    direct = s->set.estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
     lobe = sample_bsdf(&b, wo, wk, &next.from, &f_cos, &pdf);   /* next.from: wi */
     if (lobe < 0) return add(Le, direct);
     next.beta = mul(path->beta, f_cos);
@@ -1051,7 +1073,7 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
 {
     real q, m = beta->x > beta->y ? beta->x : beta->y;
     if (m < beta->z) m = beta->z;
-    if (!s->roulette || rays < ROULETTE_FROM) return 1;
+    if (!s->set.roulette || rays < ROULETTE_FROM) return 1;
     q = m < (real)0.95 ? m : (real)0.95;
     if (!(bounce_random(wk, ROULETTE) < q)) return 0;
     *beta = scale(1 / q, *beta);
@@ -1068,11 +1090,11 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path)
 {
     const Material *m = &s->mat[h->mat];
-    int l = s->emitter[h->obj];
+    int l = s->lights.emitter[h->obj];
     real w = 1;
     if (!(m->kl > 0) || !front_emits(s, h->obj, h->ng, wo)) return v3(0, 0, 0);
-    if (!path->counted && l >= 0 && s->estimator == NEE) return v3(0, 0, 0);
-    if (!path->counted && l >= 0 && s->estimator == MIS)
+    if (!path->counted && l >= 0 && s->set.estimator == NEE) return v3(0, 0, 0);
+    if (!path->counted && l >= 0 && s->set.estimator == MIS)
         w = power_heuristic(path->pdf, light_pdf(s, l, path->from, path->n_from, h->p, h->ng));
     return scale(w * m->kl, m->color);
 }
@@ -1082,9 +1104,9 @@ static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path)
 static vec sky(const Scene *s, vec d, const Path *path)
 {
     real w = 1;
-    if (!path->counted && s->estimator == NEE) return v3(0, 0, 0);
-    if (!path->counted && s->estimator == MIS && s->sky >= 0)
-        w = power_heuristic(path->pdf, light_pdf(s, s->sky, path->from, path->n_from, d, d));
+    if (!path->counted && s->set.estimator == NEE) return v3(0, 0, 0);
+    if (!path->counted && s->set.estimator == MIS && s->lights.sky >= 0)
+        w = power_heuristic(path->pdf, light_pdf(s, s->lights.sky, path->from, path->n_from, d, d));
     return scale(w, s->background);
 }
 
@@ -1116,10 +1138,10 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
     if (!(cosi > 0) || (f.x == 0 && f.y == 0 && f.z == 0)) return v3(0, 0, 0);
     wk->count.shadow++;
     r = spawn(s, h, wi);
-    if (s->emit[l].type == SPHERE_LIGHT || s->emit[l].type == TRIANGLE_LIGHT)
-        r.skip = s->emit[l].obj;          /* the light itself does not block */
+    if (s->lights.emit[l].type == SPHERE_LIGHT || s->lights.emit[l].type == TRIANGLE_LIGHT)
+        r.skip = s->lights.emit[l].obj;          /* the light itself does not block */
     if (any_hit(s, r, dist, &wk->blocker[l % SHADOW_SLOTS], wk)) return v3(0, 0, 0);
-    if (!delta && s->estimator == MIS) pdf /= power_heuristic(pdf, bsdf_pdf(b, wo, wi));
+    if (!delta && s->set.estimator == MIS) pdf /= power_heuristic(pdf, bsdf_pdf(b, wo, wi));
     return scale(cosi / pdf, mul(f, Le));
 }
 
@@ -1131,13 +1153,13 @@ static real luminance(vec c) { return (real)0.2126 * c.x + (real)0.7152 * c.y + 
 static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, real power,
                         double *total)
 {
-    s->emit[s->nemit].type = type;
-    s->emit[s->nemit].obj = obj;
-    s->emit[s->nemit].pos = pos;
-    s->emit[s->nemit].intensity = intensity;
+    s->lights.emit[s->lights.nemit].type = type;
+    s->lights.emit[s->lights.nemit].obj = obj;
+    s->lights.emit[s->lights.nemit].pos = pos;
+    s->lights.emit[s->lights.nemit].intensity = intensity;
     *total += power;
-    s->emit_cdf[s->nemit++] = (real)*total;
-    if (obj >= 0) s->emitter[obj] = s->nemit - 1;
+    s->lights.emit_cdf[s->lights.nemit++] = (real)*total;
+    if (obj >= 0) s->lights.emitter[obj] = s->lights.nemit - 1;
 }
 
 /* The path tracer's lights, each with its power, so that sample_light can
@@ -1152,13 +1174,13 @@ static void prepare_lights(Scene *s)
     double total = 0;
     int i, k, n = nobj(s);
     size_t most = (size_t)s->nlight + n + 1;      /* point lights, objects, the sky */
-    s->emitter = malloc(((size_t)n + 1) * sizeof *s->emitter);
-    s->emit = malloc(most * sizeof *s->emit);
-    s->emit_cdf = malloc(most * sizeof *s->emit_cdf);
-    if (!s->emitter || !s->emit || !s->emit_cdf) out_of_memory();
-    s->nemit = 0;
-    for (i = 0; i < n; i++) s->emitter[i] = -1;
-    s->sky = -1;
+    s->lights.emitter = malloc(((size_t)n + 1) * sizeof *s->lights.emitter);
+    s->lights.emit = malloc(most * sizeof *s->lights.emit);
+    s->lights.emit_cdf = malloc(most * sizeof *s->lights.emit_cdf);
+    if (!s->lights.emitter || !s->lights.emit || !s->lights.emit_cdf) out_of_memory();
+    s->lights.nemit = 0;
+    for (i = 0; i < n; i++) s->lights.emitter[i] = -1;
+    s->lights.sky = -1;
     for (i = 0; i < s->nlight; i++)
         if (s->light[i].sphere < 0)
             add_emitter(s, POINT_LIGHT, -1, s->light[i].pos, s->light[i].color,
@@ -1179,22 +1201,22 @@ static void prepare_lights(Scene *s)
                     v3(0, 0, 0), (real)PI * m->kl * luminance(m->color) * area, &total);
     }
     if (luminance(s->background) > 0) {
-        s->sky = s->nemit;
+        s->lights.sky = s->lights.nemit;
         add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), total > 0 ? (real)total : 1,
                     &total);
     }
-    for (i = 0; i < s->nemit; i++) s->emit_cdf[i] = total > 0 ? s->emit_cdf[i] / (real)total : 0;
-    if (s->nemit > 0) s->emit_cdf[s->nemit - 1] = 1;
+    for (i = 0; i < s->lights.nemit; i++) s->lights.emit_cdf[i] = total > 0 ? s->lights.emit_cdf[i] / (real)total : 0;
+    if (s->lights.nemit > 0) s->lights.emit_cdf[s->lights.nemit - 1] = 1;
 }
 
 /* The light whose share of the total power holds u, or -1 without lights. */
 static int choose_light(const Scene *s, real u)
 {
-    int lo = 0, hi = s->nemit - 1;
-    if (s->nemit == 0) return -1;
+    int lo = 0, hi = s->lights.nemit - 1;
+    if (s->lights.nemit == 0) return -1;
     while (lo < hi) {               /* the first light whose cdf exceeds u */
         int mid = (lo + hi) / 2;
-        if (s->emit_cdf[mid] > u) hi = mid;
+        if (s->lights.emit_cdf[mid] > u) hi = mid;
         else lo = mid + 1;
     }
     return lo;
@@ -1203,7 +1225,7 @@ static int choose_light(const Scene *s, real u)
 /* The chance that choose_light picks light l. */
 static real light_choice(const Scene *s, int l)
 {
-    return s->emit_cdf[l] - (l > 0 ? s->emit_cdf[l - 1] : 0);
+    return s->lights.emit_cdf[l] - (l > 0 ? s->lights.emit_cdf[l - 1] : 0);
 }
 
 /* A direction wi from x towards a point of light l, the distance dist to
@@ -1213,7 +1235,7 @@ static real light_choice(const Scene *s, int l)
 static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *wi,
                           real *dist, vec *Le, real *pdf)
 {
-    const Emitter *e = &s->emit[l];
+    const Emitter *e = &s->lights.emit[l];
     const Material *m;
     real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V);
     vec y, ny;
@@ -1255,7 +1277,7 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *
  * for a light found by BSDF sampling.  For the sky, y is the direction. */
 static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny)
 {
-    const Emitter *e = &s->emit[l];
+    const Emitter *e = &s->lights.emit[l];
     vec d;
     real dist;
     int k;
@@ -1436,17 +1458,17 @@ static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk)
 {
     real ti;
     int i, best = -1;
-    if (s->accel != ACCEL_NONE) {
+    if (s->accel.which != ACCEL_NONE) {
         double o[3], d[3], tmax = INFINITY;
         prim_counters c = { 0, 0, 0 };
         to3(q->r.o, o);
         to3(q->r.d, d);
-        if (s->accel == ACCEL_KD)
-            best = kd_nearest(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
-        else if (s->accel == ACCEL_BVH)
-            best = bvh_nearest(s->bvh, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
+        if (s->accel.which == ACCEL_KD)
+            best = kd_nearest(s->accel.kd, &s->accel.prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
+        else if (s->accel.which == ACCEL_BVH)
+            best = bvh_nearest(s->accel.bvh, &s->accel.prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
         else
-            best = grid_nearest(s->grid, &s->prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
+            best = grid_nearest(s->accel.grid, &s->accel.prims, o, d, q, q->r.skip, q->r.tmin, &tmax, &c);
         *t = (real)tmax;
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
@@ -1559,7 +1581,7 @@ static int any_hit(const Scene *s, Ray r, real tmax, int *last, Worker *wk)
     int hit;
     Query q;
     wk->count.queries++;
-    if (s->accel != ACCEL_NONE && *last >= 0) {
+    if (s->accel.which != ACCEL_NONE && *last >= 0) {
         wk->count.tests++;
         if (hit_object(s, *last, &r, tmax, &t)) return 1;
     }
@@ -1574,18 +1596,18 @@ static int find_any(const Scene *s, Query *q, real tmax, Worker *wk)
 {
     real t;
     int i;
-    if (s->accel != ACCEL_NONE) {
+    if (s->accel.which != ACCEL_NONE) {
         double o[3], d[3];
         prim_counters c = { 0, 0, 0 };
         int hit;
         to3(q->r.o, o);
         to3(q->r.d, d);
-        if (s->accel == ACCEL_KD)
-            hit = kd_any(s->kd, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
-        else if (s->accel == ACCEL_BVH)
-            hit = bvh_any(s->bvh, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
+        if (s->accel.which == ACCEL_KD)
+            hit = kd_any(s->accel.kd, &s->accel.prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
+        else if (s->accel.which == ACCEL_BVH)
+            hit = bvh_any(s->accel.bvh, &s->accel.prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
         else
-            hit = grid_any(s->grid, &s->prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
+            hit = grid_any(s->accel.grid, &s->accel.prims, o, d, q, q->r.skip, q->r.tmin, tmax, &c);
         wk->count.steps += c.steps;
         wk->count.tests += c.tests;
         return hit;
@@ -1667,8 +1689,8 @@ static double probe(const Scene *s, double limit)
     for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
     for (j = 0; j < PROBE && spent <= limit; j++) {
         for (i = 0; i < PROBE; i++)
-            trace(s, camera_ray(&s->cam, s->w, s->h, (i + (real)0.5) * s->w / PROBE,
-                                (j + (real)0.5) * s->h / PROBE), s->depth, 1, &wk);
+            trace(s, camera_ray(&s->cam, s->set.w, s->set.h, (i + (real)0.5) * s->set.w / PROBE,
+                                (j + (real)0.5) * s->set.h / PROBE), s->set.depth, 1, &wk);
         spent = (double)(clock() - start) / CLOCKS_PER_SEC;
     }
     return spent;
@@ -1678,10 +1700,10 @@ static double probe(const Scene *s, double limit)
  * out of memory. */
 static int build_one(Scene *s, int which)
 {
-    s->accel = which;
-    if (which == ACCEL_BVH) return (s->bvh = bvh_build(nobj(s), &s->prims, BVH_SAH)) != NULL;
-    if (which == ACCEL_GRID) return (s->grid = grid_build(nobj(s), &s->prims)) != NULL;
-    return (s->kd = kd_build(nobj(s), &s->prims)) != NULL;
+    s->accel.which = which;
+    if (which == ACCEL_BVH) return (s->accel.bvh = bvh_build(nobj(s), &s->accel.prims, BVH_SAH)) != NULL;
+    if (which == ACCEL_GRID) return (s->accel.grid = grid_build(nobj(s), &s->accel.prims)) != NULL;
+    return (s->accel.kd = kd_build(nobj(s), &s->accel.prims)) != NULL;
 }
 
 /* auto: each structure is built and renders the probe; the one whose build
@@ -1698,7 +1720,7 @@ static int build_one(Scene *s, int which)
 static int choose_accel(Scene *s)
 {
     static const int which[3] = { ACCEL_BVH, ACCEL_GRID, ACCEL_KD };
-    double best = HUGE_VAL, cost, built = 0, scale = (double)s->w * s->h / (PROBE * PROBE);
+    double best = HUGE_VAL, cost, built = 0, scale = (double)s->set.w * s->set.h / (PROBE * PROBE);
     int k, pick = 0;
     for (k = 0; k < 3; k++) {
         clock_t start = clock();
@@ -1711,11 +1733,11 @@ static int choose_accel(Scene *s)
     }
     for (k = 0; k < 3; k++) {
         if (k == pick) continue;
-        if (which[k] == ACCEL_KD && s->kd) kd_free(s->kd), s->kd = NULL;
-        if (which[k] == ACCEL_BVH) bvh_free(s->bvh), s->bvh = NULL;
-        if (which[k] == ACCEL_GRID) grid_free(s->grid), s->grid = NULL;
+        if (which[k] == ACCEL_KD && s->accel.kd) kd_free(s->accel.kd), s->accel.kd = NULL;
+        if (which[k] == ACCEL_BVH) bvh_free(s->accel.bvh), s->accel.bvh = NULL;
+        if (which[k] == ACCEL_GRID) grid_free(s->accel.grid), s->accel.grid = NULL;
     }
-    s->accel = which[pick];
+    s->accel.which = which[pick];
     return 1;
 }
 
@@ -1726,12 +1748,12 @@ static int choose_accel(Scene *s)
 static int build_accel(Scene *s, const char *accel)
 {
     int ok;
-    s->prims.bounds = prim_bounds;
-    s->prims.clip = prim_clip;
-    s->prims.hit = prim_hit;
-    s->prims.user = s;
-    s->prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
-    s->accel = ACCEL_NONE;
+    s->accel.prims.bounds = prim_bounds;
+    s->accel.prims.clip = prim_clip;
+    s->accel.prims.hit = prim_hit;
+    s->accel.prims.user = s;
+    s->accel.prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
+    s->accel.which = ACCEL_NONE;
     if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
     if (!float_range(s)) {
         fprintf(stderr, "ray: warning: coordinates beyond the float range the structures keep their"
@@ -2332,11 +2354,11 @@ void splat(const Scene *s, Worker *wk, real x, real y, vec L)
 {
     double c[3];
     int a, i = (int)floor(x), j = (int)floor(y);
-    if (!wk->splat || i < 0 || j < 0 || i >= s->w || j >= s->h) return;
+    if (!wk->splat || i < 0 || j < 0 || i >= s->set.w || j >= s->set.h) return;
     to3(L, c);
     for (a = 0; a < 3; a++)
         if (c[a] > 0)               /* NaN too is left out */
-            wk->splat[3 * ((size_t)j * s->w + i) + a] += (long long)(fmin(c[a], SPLAT_MAX) * SPLAT_ONE);
+            wk->splat[3 * ((size_t)j * s->set.w + i) + a] += (long long)(fmin(c[a], SPLAT_MAX) * SPLAT_ONE);
 }
 
 /* Every thread's splats summed, then added to the image of the pixels'
@@ -2344,14 +2366,14 @@ void splat(const Scene *s, Worker *wk, real x, real y, vec L)
 static void add_splats(const Scene *s, const Options *o, long long **splats, int nthreads,
                        const Image *own, Image *img)
 {
-    size_t at, n = (size_t)s->w * s->h;
+    size_t at, n = (size_t)s->set.w * s->set.h;
     int t, i, j;
     for (at = 0; at < 3 * n; at++)
         for (t = 1; t < nthreads; t++) splats[0][at] += splats[t][at];
-    for (j = 0; j < s->h; j++)
-        for (i = 0; i < s->w; i++) {
-            const float *f = own->floats + 3 * ((size_t)j * s->w + i);
-            const long long *q = splats[0] + 3 * ((size_t)j * s->w + i);
+    for (j = 0; j < s->set.h; j++)
+        for (i = 0; i < s->set.w; i++) {
+            const float *f = own->floats + 3 * ((size_t)j * s->set.w + i);
+            const long long *q = splats[0] + 3 * ((size_t)j * s->set.w + i);
             put_pixel(img, i, j, v3((real)(f[0] + q[0] / SPLAT_ONE / o->spp),
                                     (real)(f[1] + q[1] / SPLAT_ONE / o->spp),
                                     (real)(f[2] + q[2] / SPLAT_ONE / o->spp)));
@@ -2366,7 +2388,7 @@ static void add_splats(const Scene *s, const Options *o, long long **splats, int
  * added to the pixels at the end (add_splats). */
 static void render(const Scene *s, const Options *o, Image *img, Counts *total)
 {
-    int done = 0, stride = row_stride(s->h), nthreads = 1, splats = o->hooks && o->hooks->after_sample;
+    int done = 0, stride = row_stride(s->set.h), nthreads = 1, splats = o->hooks && o->hooks->after_sample;
     long long **splat = NULL;
     Image own = *img;
 #ifdef _OPENMP
@@ -2377,9 +2399,9 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
     if (splats) {
         int t;
         splat = calloc((size_t)nthreads, sizeof *splat);
-        if (!splat || !new_image(&own, s->w, s->h, 1, 0)) out_of_memory();
+        if (!splat || !new_image(&own, s->set.w, s->set.h, 1, 0)) out_of_memory();
         for (t = 0; t < nthreads; t++)
-            if (!(splat[t] = calloc((size_t)s->w * s->h * 3, sizeof **splat))) out_of_memory();
+            if (!(splat[t] = calloc((size_t)s->set.w * s->set.h * 3, sizeof **splat))) out_of_memory();
     }
     OMP(omp parallel num_threads(nthreads))
     {
@@ -2395,16 +2417,16 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         if (splats) wk.splat = splat[0];
 #endif
         OMP(omp for schedule(dynamic, 1))
-        for (k = 0; k < s->h; k++) {
+        for (k = 0; k < s->set.h; k++) {
             int i, mine;
             /* a row starts with an empty shadow cache, so that the counts
              * do not depend on which thread had the row before */
             for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
-            render_row(s, (int)((long long)k * stride % s->h), o->spp, &own, &wk);
+            render_row(s, (int)((long long)k * stride % s->set.h), o->spp, &own, &wk);
             OMP(omp atomic capture)
             mine = ++done;
-            if (o->progress && (mine * 100 / s->h != (mine - 1) * 100 / s->h))
-                show_progress(o->start, mine, s->h);
+            if (o->progress && (mine * 100 / s->set.h != (mine - 1) * 100 / s->set.h))
+                show_progress(o->start, mine, s->set.h);
         }
         OMP(omp critical)
         add_counts(total, &wk.count);
@@ -2468,12 +2490,12 @@ static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
     Hit h;
     int hit;
     wk->count.primary++;
-    hit = nearest_hit(s, camera_ray(&s->cam, s->w, s->h, i + (real)0.5, j + (real)0.5), &h, wk);
-    if (s->view == VIEW_STEPS)
+    hit = nearest_hit(s, camera_ray(&s->cam, s->set.w, s->set.h, i + (real)0.5, j + (real)0.5), &h, wk);
+    if (s->set.view == VIEW_STEPS)
         return heat((real)(wk->count.steps - before.steps + wk->count.tests - before.tests));
     if (!hit) return v3(0, 0, 0);
-    if (s->view == VIEW_NORMAL) return scale((real)0.5, add(h.n, v3(1, 1, 1)));
-    return v3(1 - h.t / s->far, 1 - h.t / s->far, 1 - h.t / s->far);
+    if (s->set.view == VIEW_NORMAL) return scale((real)0.5, add(h.n, v3(1, 1, 1)));
+    return v3(1 - h.t / s->set.far, 1 - h.t / s->set.far, 1 - h.t / s->set.far);
 }
 
 /* ------------------------------------------------------------- scene input */
@@ -2594,12 +2616,12 @@ static void build_setting(void *user, int what, const double *v, const char *wor
     Scene *s = user;
     int i;
     switch (what) {
-    case SET_SIZE: s->w = (int)v[0]; s->h = (int)v[1]; break;
-    case SET_DEPTH: s->depth = s->max_rays = (int)v[0]; break;
-    case SET_SAMPLES: s->spp = (int)v[0]; break;
+    case SET_SIZE: s->set.w = (int)v[0]; s->set.h = (int)v[1]; break;
+    case SET_DEPTH: s->set.depth = s->set.max_rays = (int)v[0]; break;
+    case SET_SAMPLES: s->set.spp = (int)v[0]; break;
     case SET_HITHER: s->cam.hither = (real)v[0]; break;
     case SET_TIR_REFLECT: s->tir_reflect = v[0] != 0; break;
-    case SET_PATH: s->integrator = v[0] != 0 ? PATH : WHITTED; break;
+    case SET_PATH: s->set.integrator = v[0] != 0 ? PATH : WHITTED; break;
     case SET_AMBIENT: s->ambient = vec_of(v); break;
     case SET_BACKGROUND: s->background = vec_of(v); break;
     case SET_PIXEL_CORNER: s->cam.anchor = v[0] != 0 ? 0 : (real)0.5; break;
@@ -2607,7 +2629,7 @@ static void build_setting(void *user, int what, const double *v, const char *wor
     case SET_LIGHT_SCALE:
         for (i = 0; i < s->nlight; i++) s->light[i].color = scale((real)v[0], s->light[i].color);
         break;
-    case SET_ACCEL: s->accel_line = word; break;
+    case SET_ACCEL: s->set.accel_line = word; break;
     }
 }
 
@@ -2636,13 +2658,13 @@ static void default_scene(Scene *s)
     real v[10] = { 0, 0, 0, 0, 1, 0, 0, 0, 1, 45 };
     char why[SCENE_WHY];
     memset(s, 0, sizeof *s);
-    s->w = s->h = 512;
-    s->depth = 5;
+    s->set.w = s->set.h = 512;
+    s->set.depth = 5;
     s->cam.anchor = (real)0.5;
-    s->integrator = WHITTED;
-    s->estimator = MIS;
-    s->roulette = 1;
-    s->sky = -1;
+    s->set.integrator = WHITTED;
+    s->set.estimator = MIS;
+    s->set.roulette = 1;
+    s->lights.sky = -1;
     set_camera(s, v, why);
 }
 
@@ -2680,14 +2702,14 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.spheres = s->nsph, st.cones = s->ncone, st.triangles = s->ntri, st.objects = nobj(s);
     for (i = 0; i < s->nlight; i++) st.point_lights += s->light[i].sphere < 0;
     st.glowing = glowing(s);
-    st.w = s->w, st.h = s->h, st.spp = spp, st.threads = c->threads, st.depth = s->depth;
-    st.path = s->integrator == PATH;
-    st.estimator = s->estimator;
-    st.roulette = s->roulette, st.max_rays = s->max_rays, st.seed = s->seed, st.lights = s->nemit;
-    st.accel = accels[s->accel];
-    if (s->accel == ACCEL_KD) kd_describe(s->kd, &st.kd);
-    if (s->accel == ACCEL_BVH) bvh_describe(s->bvh, &st.bvh);
-    if (s->accel == ACCEL_GRID) grid_describe(s->grid, &st.grid);
+    st.w = s->set.w, st.h = s->set.h, st.spp = spp, st.threads = c->threads, st.depth = s->set.depth;
+    st.path = s->set.integrator == PATH;
+    st.estimator = s->set.estimator;
+    st.roulette = s->set.roulette, st.max_rays = s->set.max_rays, st.seed = s->set.seed, st.lights = s->lights.nemit;
+    st.accel = accels[s->accel.which];
+    if (s->accel.which == ACCEL_KD) kd_describe(s->accel.kd, &st.kd);
+    if (s->accel.which == ACCEL_BVH) bvh_describe(s->accel.bvh, &st.bvh);
+    if (s->accel.which == ACCEL_GRID) grid_describe(s->accel.grid, &st.grid);
     st.primary = c->primary, st.shadow = c->shadow, st.reflected = c->reflected;
     st.refracted = c->refracted, st.bounced = c->bounced, st.cut = c->cut, st.budget = RAY_BUDGET;
     st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
@@ -2698,24 +2720,24 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
 
 static void free_scene(Scene *s)
 {
-    if (s->kd) kd_free(s->kd);
-    if (s->bvh) bvh_free(s->bvh);
-    if (s->grid) grid_free(s->grid);
+    if (s->accel.kd) kd_free(s->accel.kd);
+    if (s->accel.bvh) bvh_free(s->accel.bvh);
+    if (s->accel.grid) grid_free(s->accel.grid);
     free(s->mat); free(s->sph); free(s->cone); free(s->tri);
     free(s->vert); free(s->norm); free(s->light);
-    free(s->emit); free(s->emit_cdf); free(s->emitter);
+    free(s->lights.emit); free(s->lights.emit_cdf); free(s->lights.emitter);
 }
 
 /* The command line's choices for the path tracer (-1: not given) onto the
  * scene, and its lights; 0 with a message when they cannot work. */
 static int settle_path_options(Scene *s, int integrator, int estimator, int roulette, long seed)
 {
-    if (integrator >= 0) s->integrator = integrator;
-    if (estimator >= 0) s->estimator = estimator;
-    if (seed >= 0) s->seed = (unsigned)seed;
-    s->roulette = roulette;
-    if (s->integrator != PATH) return 1;
-    if (!roulette && !s->max_rays) {
+    if (integrator >= 0) s->set.integrator = integrator;
+    if (estimator >= 0) s->set.estimator = estimator;
+    if (seed >= 0) s->set.seed = (unsigned)seed;
+    s->set.roulette = roulette;
+    if (s->set.integrator != PATH) return 1;
+    if (!roulette && !s->set.max_rays) {
         fprintf(stderr, "ray: --no-roulette needs -d N (or the scene's `depth`): without either,"
                 " paths would not end\n");
         return 0;
@@ -2742,35 +2764,35 @@ int main(int argc, char **argv)
     if (done >= 0) return done;
     load = now();
     ok = load_scene(&s, a.scene);
-    if (ok && a.w) { s.w = a.w; s.h = a.h; }
+    if (ok && a.w) { s.set.w = a.w; s.set.h = a.h; }
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", a.scene);
-    if (a.depth) s.depth = s.max_rays = a.depth;
-    accel = a.accel ? a.accel : s.accel_line ? s.accel_line : "auto";
+    if (a.depth) s.set.depth = s.set.max_rays = a.depth;
+    accel = a.accel ? a.accel : s.set.accel_line ? s.set.accel_line : "auto";
     if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {
         free_scene(&s); free(a.made);
         return 2;                   /* --no-roulette without -d: a usage error */
     }
     memset(&o, 0, sizeof o);
-    o.spp = a.spp ? a.spp : s.spp ? s.spp : 1;
+    o.spp = a.spp ? a.spp : s.set.spp ? s.set.spp : 1;
     o.threads = a.threads;
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
     if (!ok || !open_output(&out, a.output)) { free_scene(&s); free(a.made); return 1; }
 
-    s.view = a.view;
-    if (a.view == VIEW_DEPTH) s.far = farthest(&s);
-    if (!new_image(&img, s.w, s.h, out.format == FORMAT_PFM, !a.view && (s.integrator == PATH || a.gamma))) {
-        fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.w, s.h);
+    s.set.view = a.view;
+    if (a.view == VIEW_DEPTH) s.set.far = farthest(&s);
+    if (!new_image(&img, s.set.w, s.set.h, out.format == FORMAT_PFM, !a.view && (s.set.integrator == PATH || a.gamma))) {
+        fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.set.w, s.set.h);
         discard_output(&out);
         free_scene(&s); free(a.made);
         return 1;
     }
     o.progress = stderr_is_terminal();
     memset(&st, 0, sizeof st);
-    if (s.integrator == PATH ? s.warning[0] : s.whitted_warning[0])
-        fprintf(stderr, "%s\n", s.integrator == PATH ? s.warning : s.whitted_warning);
+    if (s.set.integrator == PATH ? s.warning[0] : s.whitted_warning[0])
+        fprintf(stderr, "%s\n", s.set.integrator == PATH ? s.warning : s.whitted_warning);
     t0 = o.start = now();
     c0 = clock();
     render(&s, &o, &img, &st);

@@ -325,9 +325,9 @@ static int rb_white(Scene *s)
  * and naming each would tie the bench to every field of a Scene in flux. */
 static void rb_free_scene(Scene *s)
 {
-    if (s->kd) kd_free(s->kd);
-    if (s->bvh) bvh_free(s->bvh);
-    if (s->grid) grid_free(s->grid);
+    if (s->accel.kd) kd_free(s->accel.kd);
+    if (s->accel.bvh) bvh_free(s->accel.bvh);
+    if (s->accel.grid) grid_free(s->accel.grid);
     free(s->mat); free(s->sph); free(s->tri); free(s->vert); free(s->norm); free(s->light);
 }
 
@@ -343,7 +343,7 @@ static void rb_load_mesh(Scene *s, const char *path)
 static double rb_build(Scene *s)
 {
     double c0 = rb_cpu();
-    if (!build_accel(s, "kd") || !s->kd) rb_die("kd-tree build failed", NULL);
+    if (!build_accel(s, "kd") || !s->accel.kd) rb_die("kd-tree build failed", NULL);
     return rb_cpu() - c0;
 }
 
@@ -351,7 +351,7 @@ static double rb_build(Scene *s)
 static void rb_tree_line(const Scene *s, double seconds)
 {
     kd_info k;
-    kd_describe(s->kd, &k);
+    kd_describe(s->accel.kd, &k);
     printf("kd-tree    %d objects, built in %.3f s (CPU): %ld nodes, depth %ld, %.2f refs/object, "
            "%.1f bytes/object, SAH cost %.2f\n", nobj(s), seconds, k.nodes, k.max_depth,
            (double)k.prim_refs / nobj(s), (double)k.bytes / nobj(s), k.sah_cost);
@@ -408,7 +408,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
         if (bare) {
             double o[3], d[3], tmax = INFINITY;
             Query q = rb_query(&rays[i], o, d);
-            obj[i] = kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
+            obj[i] = kd_nearest(s->accel.kd, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
             t[i] = tmax;
             rb_uvn(s, obj[i], &q, uvn + 5 * i);
         } else {
@@ -479,18 +479,18 @@ static void rb_work(Scene *s, const char *set, const RbRay *rays, long n)
 {
     prim_counters c = { 0, 0, 0 };
     long i;
-    rb_probe.hit = s->prims.hit;
+    rb_probe.hit = s->accel.prims.hit;
     rb_probe.mark = calloc((size_t)nobj(s), sizeof *rb_probe.mark);
     rb_probe.tests = rb_probe.repeats = 0;
     if (!rb_probe.mark) rb_die("out of memory", NULL);
-    s->prims.hit = rb_counting_hit;
+    s->accel.prims.hit = rb_counting_hit;
     for (i = 0; i < n; i++) {
         double o[3], d[3], tmax = INFINITY;
         Query q = rb_query(&rays[i], o, d);
         rb_probe.ray = (unsigned long)i + 1;
-        kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, &c);
+        kd_nearest(s->accel.kd, &s->accel.prims, o, d, &q, -1, 0, &tmax, &c);
     }
-    s->prims.hit = rb_probe.hit;
+    s->accel.prims.hit = rb_probe.hit;
     free(rb_probe.mark);
     printf("work       %.1f tree steps and %.2f hit tests per ray; %.1f%% of the tests repeat a "
            "primitive already tested for that ray\n", (double)c.steps / n, (double)rb_probe.tests / n,
@@ -602,7 +602,7 @@ typedef struct {
 
 static double rb_cpu_build(RbAll *A, int which)
 {
-    const prims *p = &A->s->prims;
+    const prims *p = &A->s->accel.prims;
     double c0 = rb_cpu();
     int n = nobj(A->s);
     switch (which) {
@@ -647,7 +647,7 @@ static void rb_build_all(RbAll *A)
 static int rb_nearest_with(const RbAll *A, int which, const double o[3], const double d[3],
                            Query *q, double *t, prim_counters *c)
 {
-    const prims *p = &A->s->prims;
+    const prims *p = &A->s->accel.prims;
     int i, best = -1, n = nobj(A->s);
     switch (which) {
     case RB_KD: return kd_nearest(A->kd, p, o, d, q, -1, 0, t, c);
@@ -928,9 +928,9 @@ static double rb_trace_cpu(const Scene *s, const RbRay *rays, long n)
     for (i = 0; i < n; i++) {
         double o[3], d[3], tmax = INFINITY;
         Query q = rb_query(&rays[i], o, d);
-        if (s->accel == ACCEL_KD) kd_nearest(s->kd, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
-        else if (s->accel == ACCEL_BVH) bvh_nearest(s->bvh, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
-        else grid_nearest(s->grid, &s->prims, o, d, &q, -1, 0, &tmax, NULL);
+        if (s->accel.which == ACCEL_KD) kd_nearest(s->accel.kd, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
+        else if (s->accel.which == ACCEL_BVH) bvh_nearest(s->accel.bvh, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
+        else grid_nearest(s->accel.grid, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
     }
     return rb_cpu() - c0;
 }
@@ -940,11 +940,11 @@ static double rb_trace_cpu(const Scene *s, const RbRay *rays, long n)
 static double rb_frame(Scene *s, int strategy, const RbRay *rays, long n, double *build)
 {
     double c0 = rb_cpu();
-    if (strategy == 2 && s->bvh) bvh_refit(s->bvh, &s->prims);
+    if (strategy == 2 && s->accel.bvh) bvh_refit(s->accel.bvh, &s->accel.prims);
     else {
-        if (s->kd) kd_free(s->kd), s->kd = NULL;
-        if (s->bvh) bvh_free(s->bvh), s->bvh = NULL;
-        if (s->grid) grid_free(s->grid), s->grid = NULL;
+        if (s->accel.kd) kd_free(s->accel.kd), s->accel.kd = NULL;
+        if (s->accel.bvh) bvh_free(s->accel.bvh), s->accel.bvh = NULL;
+        if (s->accel.grid) grid_free(s->accel.grid), s->accel.grid = NULL;
         if (!build_accel(s, strategy == 0 ? "kd" : strategy == 3 ? "grid" : "bvh")) exit(1);
     }
     *build = rb_cpu() - c0;
@@ -1010,9 +1010,9 @@ static void rb_anim(const char *path, int frames, int movers, int rounds)
     for (round = 0; round < rounds; round++) {
         double build[4] = { 0 }, trace[4] = { 0 };
         for (k = 0; k < 4; k++) {   /* each round starts from nothing: frame 0 builds */
-            if (s[k].kd) kd_free(s[k].kd), s[k].kd = NULL;
-            if (s[k].bvh) bvh_free(s[k].bvh), s[k].bvh = NULL;
-            if (s[k].grid) grid_free(s[k].grid), s[k].grid = NULL;
+            if (s[k].accel.kd) kd_free(s[k].accel.kd), s[k].accel.kd = NULL;
+            if (s[k].accel.bvh) bvh_free(s[k].accel.bvh), s[k].accel.bvh = NULL;
+            if (s[k].accel.grid) grid_free(s[k].accel.grid), s[k].accel.grid = NULL;
         }
         for (f = 0; f < frames; f++) {
             double b[4], t[4];
@@ -1147,7 +1147,7 @@ static RbDRay *rb_far_random(const Scene *s, long n, double off)
  * 3 the loop over every object), its t in *t. */
 static int rb_far_nearest(const RbFar *F, int which, const RbDRay *r, double *t, prim_counters *c)
 {
-    const prims *p = &F->s.prims;
+    const prims *p = &F->s.accel.prims;
     Ray ry;
     Query q;
     int i, best = -1, n = nobj(&F->s);
@@ -1183,9 +1183,9 @@ static void rb_far_setup(RbFar *F, const char *path, int cfg, int w, int h, long
     if (rb_far_dist[cfg] == 0) F->rays[1] = rb_far_random(&F->s, nrand, rb_far_off[cfg]), F->n[1] = nrand;
     rb_far_translate(&F->s, rb_far_off[cfg]);
     if (!build_accel(&F->s, "none")) exit(1);
-    F->kd = kd_build(nobj(&F->s), &F->s.prims);
-    F->bvh = bvh_build(nobj(&F->s), &F->s.prims, BVH_SAH);
-    F->grid = grid_build(nobj(&F->s), &F->s.prims);
+    F->kd = kd_build(nobj(&F->s), &F->s.accel.prims);
+    F->bvh = bvh_build(nobj(&F->s), &F->s.accel.prims, BVH_SAH);
+    F->grid = grid_build(nobj(&F->s), &F->s.accel.prims);
     if (!F->kd || !F->bvh || !F->grid) rb_die("out of memory building the structures", NULL);
     for (k = 0; k < 2; k++) {
         if (!F->rays[k]) continue;
@@ -1201,7 +1201,7 @@ static void rb_far_free(RbFar *F)
 {
     int k;
     kd_free(F->kd), bvh_free(F->bvh), grid_free(F->grid);
-    F->s.kd = NULL, F->s.bvh = NULL, F->s.grid = NULL;
+    F->s.accel.kd = NULL, F->s.accel.bvh = NULL, F->s.accel.grid = NULL;
     for (k = 0; k < 2; k++) free(F->rays[k]), free(F->want[k]), free(F->want_t[k]);
     rb_free_scene(&F->s);
 }

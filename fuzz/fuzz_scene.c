@@ -182,12 +182,12 @@ static void render_tiny(Scene *s, Image *img, const char *what, int check_nan)
     Counts c;
     int k;
     memset(&c, 0, sizeof c);
-    if (!new_image(img, s->w, s->h, 1, 0)) abort();
+    if (!new_image(img, s->set.w, s->set.h, 1, 0)) abort();
     render(s, &o, img, &c);
-    for (k = 0; k < 3 * s->w * s->h && check_nan; k++)
+    for (k = 0; k < 3 * s->set.w * s->set.h && check_nan; k++)
         if (isnan(img->floats[k])) {
             fprintf(stderr, "fuzz_scene: %s: NaN at pixel (%d, %d) channel %d\n", what,
-                    k / 3 % s->w, k / 3 / s->w, k % 3);
+                    k / 3 % s->set.w, k / 3 / s->set.w, k % 3);
             abort();
         }
 }
@@ -224,14 +224,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         free_scene(&s);
         return 0;
     }
-    s.w = s.h = SIZE;
-    if (s.depth > DEPTH) s.depth = DEPTH;
+    s.set.w = s.set.h = SIZE;
+    if (s.set.depth > DEPTH) s.set.depth = DEPTH;
     in_range = !beyond_float_range(&s);
     check_nan = in_range;
     compare = in_range;
 
     /* Whitted's, through the loop and through each structure */
-    s.integrator = WHITTED;
+    s.set.integrator = WHITTED;
     if (!build_accel(&s, "none")) abort();
     render_tiny(&s, &loop, "Whitted, loop", check_nan);
     for (a = 0; a < 3 && float_range(&s); a++) {
@@ -249,7 +249,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     free(loop.floats);
 
     /* The path tracer, through the tree */
-    if (s.max_rays == 0 || s.max_rays > PATH_RAYS) s.max_rays = PATH_RAYS;
+    if (s.set.max_rays == 0 || s.set.max_rays > PATH_RAYS) s.set.max_rays = PATH_RAYS;
     if (settle_path_options(&s, PATH, -1, 1, -1)) {
         render_tiny(&s, &path, "path tracer", check_nan);
         free(path.floats);

@@ -22,9 +22,9 @@ static void prepass(const Scene *s, void *data)
  * three, so that every pixel receives from many others. */
 static void target(const Scene *s, int i, int j, int k, int *x, int *y, double *v)
 {
-    unsigned long long h = mix64(((unsigned long long)j * s->w + i) * 64 + (unsigned)k);
-    *x = (int)(h % (unsigned)s->w);
-    *y = (int)(h / 977 % (unsigned)s->h);
+    unsigned long long h = mix64(((unsigned long long)j * s->set.w + i) * 64 + (unsigned)k);
+    *x = (int)(h % (unsigned)s->set.w);
+    *y = (int)(h / 977 % (unsigned)s->set.h);
     *v = (double)(h >> 40) / (1 << 24);           /* in [0, 1) */
 }
 
@@ -46,8 +46,8 @@ static void render_with(int t, int path, Seen *seen, Image *img)
     Counts c;
     Hooks h;
     if (!load_scene(&s, "scenes/minray.sph")) exit(2);
-    s.w = 24;
-    s.h = 16;
+    s.set.w = 24;
+    s.set.h = 16;
     if (path && !settle_path_options(&s, PATH, -1, 1, -1)) exit(2);
     memset(&o, 0, sizeof o);
     memset(&c, 0, sizeof c);
@@ -58,7 +58,7 @@ static void render_with(int t, int path, Seen *seen, Image *img)
     o.spp = 3;
     o.threads = t;
     o.hooks = &h;
-    if (!build_accel(&s, "none") || !new_image(img, s.w, s.h, 1, 0)) exit(2);
+    if (!build_accel(&s, "none") || !new_image(img, s.set.w, s.set.h, 1, 0)) exit(2);
     render(&s, &o, img, &c);
     free_scene(&s);
 }
@@ -89,12 +89,12 @@ int main(void)
     /* The splats by themselves: the image with them less the plain image,
      * times the samples, is what after_sample splatted into each pixel. */
     if (!load_scene(&s, "scenes/minray.sph")) exit(2);
-    s.w = 24;
-    s.h = 16;
+    s.set.w = 24;
+    s.set.h = 16;
     memset(&o, 0, sizeof o);
     memset(&c, 0, sizeof c);
     o.spp = 3;
-    if (!build_accel(&s, "none") || !new_image(&plain, s.w, s.h, 1, 0)) exit(2);
+    if (!build_accel(&s, "none") || !new_image(&plain, s.set.w, s.set.h, 1, 0)) exit(2);
     render(&s, &o, &plain, &c);
     memset(want, 0, sizeof want);
     for (j = 0; j < 16; j++)

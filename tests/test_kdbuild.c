@@ -185,11 +185,11 @@ static long tree_vs_loop(Scene *s, const Frame *f, long n, const vec *spots, int
         Ray r = make_ray(f, k, spots, nspots);
         Hit a, b;
         int ha, hb;
-        s->accel = ACCEL_KD;
+        s->accel.which = ACCEL_KD;
         ha = nearest_hit(s, r, &a, &wk);
-        s->accel = ACCEL_NONE;
+        s->accel.which = ACCEL_NONE;
         hb = nearest_hit(s, r, &b, &wk);
-        s->accel = ACCEL_KD;
+        s->accel.which = ACCEL_KD;
         *hits += hb;
         if (ha != hb || (ha && (a.obj != b.obj || memcmp(&a.t, &b.t, sizeof a.t))))
             wrong++;
@@ -201,8 +201,8 @@ static long tree_vs_loop(Scene *s, const Frame *f, long n, const vec *spots, int
 static int build(Scene *s, kd_info *k, size_t *bytes)
 {
     held = peak = 0;
-    if (!build_accel(s, "kd") || !s->kd) return 0;
-    kd_describe(s->kd, k);
+    if (!build_accel(s, "kd") || !s->accel.kd) return 0;
+    kd_describe(s->accel.kd, k);
     *bytes = peak;
     return 1;
 }

@@ -95,7 +95,7 @@ static void camera(Scene *s, vec eye, vec at, vec up, double fov)
  * on the rays of a path (0: none), the structure, the lights. */
 static void ready(Scene *s, int estimator, int roulette, int max_rays)
 {
-    s->max_rays = max_rays;
+    s->set.max_rays = max_rays;
     build_accel(s, "auto");
     settle_path_options(s, PATH, estimator, roulette, 7);
 }
@@ -107,8 +107,8 @@ static Stat image_samples(const Scene *s, int n, int c)
     Stat st = { 0, 0, 0 };
     int k;
     for (k = 0; k < n; k++) {
-        int pixel = k % (s->w * s->h);
-        vec L = sample_radiance(s, pixel % s->w, pixel / s->w, k / (s->w * s->h), &wk);
+        int pixel = k % (s->set.w * s->set.h);
+        vec L = sample_radiance(s, pixel % s->set.w, pixel / s->set.w, k / (s->set.w * s->set.h), &wk);
         stat_add(&st, c == 0 ? L.x : c == 1 ? L.y : L.z);
     }
     return st;
@@ -136,7 +136,7 @@ static void test_furnace(void)
                     Stat st;
                     if (bounces < 0 && !roulette) continue;   /* paths would not end */
                     default_scene(&s);
-                    s.w = s.h = 8;
+                    s.set.w = s.set.h = 8;
                     add_sphere(&s, v3(1, 2, 3), 2, material(&s, v3(1, 1, 1), a, 0, 0, Le, 1, 0));
                     camera(&s, v3(1, 2, 3), v3(1, 3, 3), v3(0, 0, 1), 90);
                     ready(&s, e, roulette, bounces < 0 ? 0 : bounces + 1);
@@ -169,7 +169,7 @@ static void test_point_in_sphere(void)
         Stat st;
         double want;
         default_scene(&s);
-        s.w = s.h = 8;
+        s.set.w = s.set.h = 8;
         add_sphere(&s, v3(0, 0, 0), R, material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0));
         add_light(&s, v3(0, 0, 0), v3(I, I, I), -1);
         camera(&s, v3(0.3, -0.2, 0.1), v3(1, 1, 0.5), v3(0, 0, 1), 100);
@@ -246,7 +246,7 @@ static Stat ball_in_sky(double L, double kd, double ks, double kt, vec eye, vec 
     Scene s;
     Stat st;
     default_scene(&s);
-    s.w = s.h = 8;
+    s.set.w = s.set.h = 8;
     s.background = v3(L, L, L);
     add_sphere(&s, v3(0, 0, 0), 1, material(&s, v3(1, 1, 1), kd, ks, kt, 0, 1.5, 0));
     camera(&s, eye, at, v3(0, 0, 1), fov);
@@ -368,7 +368,7 @@ static void test_energy(void)
             Scene z = { 0 };
             Sequence q = sequence(16 * l + a);
             double head;
-            z.w = 8;                        /* pixels (l, a) apart: their own samples */
+            z.set.w = 8;                        /* pixels (l, a) apart: their own samples */
             for (k = 0; k < 200000; k++) {
                 vec wi, f_cos, wu, f;
                 real pdf;
@@ -497,8 +497,8 @@ static void test_chi2(void)
             double chi2, inside = 0, p;
             int i, j, k, dof;
             memset(observed, 0, sizeof observed);
-            z.w = 8;
-            z.seed = 2;
+            z.set.w = 8;
+            z.set.seed = 2;
             for (k = 0; k < CHI_SAMPLES; k++) {
                 vec wi, f_cos;
                 real pdf;
@@ -686,7 +686,7 @@ static void test_dimensions_distinct(void)
     Worker wk = worker();
     Scene z = { 0 };
     int k, d, e, same = 0;
-    z.w = 1000;
+    z.set.w = 1000;
     for (k = 0; k < 1000; k++) {
         real u[NC + BOUNCES * NS];
         start_sample(&wk, &z, k, 3, 5);
@@ -718,10 +718,10 @@ static void test_dimensions_fixed(void)
             report(0, "dimensions: the paths are the same for every estimator", "cannot load scenes/cornell.sph");
             return;
         }
-        s.w = s.h = 32;
+        s.set.w = s.set.h = 32;
         ready(&s, e, 1, 0);
-        for (j = 0; j < s.h; j++)
-            for (i = 0; i < s.w; i++) pixel_radiance(&s, i, j, 4, &wk);
+        for (j = 0; j < s.set.h; j++)
+            for (i = 0; i < s.set.w; i++) pixel_radiance(&s, i, j, 4, &wk);
         bounced[e] = wk.count.bounced;
         nearest[e] = wk.count.nearest;
         free_scene(&s);
@@ -769,7 +769,7 @@ static void test_estimators_agree(void)
             report(0, "the three estimators agree on the Cornell box", "cannot load scenes/cornell.sph");
             return;
         }
-        s[e].w = s[e].h = 16;
+        s[e].set.w = s[e].set.h = 16;
         ready(&s[e], e, 1, 0);
         memset(st[e], 0, sizeof st[e]);
         for (k = 0; k < 16 * 16 * 384; k++) {
@@ -802,7 +802,7 @@ static void test_glowing_cone(void)
     for (e = 0; e < 3; e++) {
         Scene s;
         default_scene(&s);
-        s.w = s.h = 8;
+        s.set.w = s.set.h = 8;
         add_cone(&s, v3(0, 0, -1), 0.5, v3(0, 0, 1), 0.5, material(&s, v3(1, 1, 1), 0, 0, 0, 2, 1, 0));
         add_sphere(&s, v3(0, 0, -3), 1.5, material(&s, v3(1, 1, 1), 0.8, 0, 0, 0, 1, 0));
         camera(&s, v3(0, -5, 0), v3(0, 0, -1), v3(0, 0, 1), 40);
@@ -831,15 +831,15 @@ static void test_seed(void)
         report(0, "another seed", "cannot load scenes/cornell.sph");
         return;
     }
-    s.w = s.h = 24;
+    s.set.w = s.set.h = 24;
     ready(&s, MIS, 1, 0);
-    for (j = 0; j < s.h; j++)
-        for (i = 0; i < s.w; i++) {
+    for (j = 0; j < s.set.h; j++)
+        for (i = 0; i < s.set.w; i++) {
             Worker wk = worker();
             vec a, b;
-            s.seed = 1;
+            s.set.seed = 1;
             a = pixel_radiance(&s, i, j, 16, &wk);
-            s.seed = 2;
+            s.set.seed = 2;
             b = pixel_radiance(&s, i, j, 16, &wk);
             same += a.x == b.x;
             stat_add(&d, luminance(sub(a, b)));

@@ -392,7 +392,7 @@ static void test_tree_matches_loop(const char *accel, int n)
     tri(&s, v3(-4, -4, -1), v3(4, -4, -1), v3(-4, 4, -1));     /* axis-aligned: splits land on it */
     tri(&s, v3(0, 0, 0), v3(0, 2, 0), v3(0, 0, 2));
     build_accel(&s, accel);
-    used = s.accel;
+    used = s.accel.which;
     for (r = 0; r < n; r++) {
         Hit a, b;
         int ha, hb;
@@ -407,9 +407,9 @@ static void test_tree_matches_loop(const char *accel, int n)
         case 4: ry.o = scale(0.01, ry.o); break;              /* inside the scene box */
         }
         ha = nearest_hit(&s, ry, &a, &wk);
-        s.accel = ACCEL_NONE;
+        s.accel.which = ACCEL_NONE;
         hb = nearest_hit(&s, ry, &b, &wk);
-        s.accel = used;
+        s.accel.which = used;
         if (ha != hb || (ha && (a.obj != b.obj || a.t != b.t))) wrong++;
     }
     {
@@ -555,15 +555,15 @@ static void test_tree_image(const char *accel)
     add_light(&s, v3(-1.5, 1.1, 0.4), v3(0.3, 0.3, 0.3), -1);
     set_camera(&s, v, (char[SCENE_WHY]){ 0 });
     build_accel(&s, accel);
-    used = s.accel;
+    used = s.accel.which;
     for (j = 0; j < W; j++) {
         for (k = 0; k < SHADOW_SLOTS; k++) wk.blocker[k] = -1;
         for (i = 0; i < W; i++) {
             Ray r = camera_ray(&s.cam, W, W, i + 0.5, j + 0.5);
-                vec a = trace(&s, r, s.depth, 1, &wk), b;
-            s.accel = ACCEL_NONE;
-            b = trace(&s, r, s.depth, 1, &wk);
-            s.accel = used;
+                vec a = trace(&s, r, s.set.depth, 1, &wk), b;
+            s.accel.which = ACCEL_NONE;
+            b = trace(&s, r, s.set.depth, 1, &wk);
+            s.accel.which = used;
             wrong += memcmp(&a, &b, sizeof a) != 0;
         }
     }
@@ -641,7 +641,7 @@ static void test_float_range(void)
         memset(&wk, 0, sizeof wk);
         for (i = 0; i < 12; i++) add_sphere(&s, v3(3 * c * i, 5 * c, 0), c, 0);
         build_accel(&s, "kd");
-        ok = ok && (s.accel == ACCEL_KD) == (k == 0);
+        ok = ok && (s.accel.which == ACCEL_KD) == (k == 0);
         ok = ok && nearest_hit(&s, ray(v3(6 * c, 0, 0), v3(0, 1, 0)), &h, &wk) && h.obj == 2;
         free_scene(&s);
     }
@@ -680,7 +680,7 @@ static void test_light_under_ceiling(void)
     build_accel(&s, "kd");
     for (accel = 0; accel < 2; accel++) {
         int wrong = 0, lit = 0, dark = 0;
-        s.accel = accel ? ACCEL_NONE : ACCEL_KD;
+        s.accel.which = accel ? ACCEL_NONE : ACCEL_KD;
         for (j = 0; j < W; j++) {
             for (k = 0; k < SHADOW_SLOTS; k++) wk.blocker[k] = -1;
             for (i = 0; i < W; i++) {
@@ -698,7 +698,7 @@ static void test_light_under_ceiling(void)
                 miss = b <= 0 || b >= len ? INFINITY : sqrt(fmax(dot(oc, oc) - b * b, 0)) - 0.5;
                 if (fabs(miss) < 1e-6) continue;              /* on the shadow's edge */
                 want = miss > 0 ? to_l.z : 0;
-                col = trace(&s, r, s.depth, 1, &wk);
+                col = trace(&s, r, s.set.depth, 1, &wk);
                 lit += want > 0, dark += want == 0;
                 wrong += !(fabs(col.x - want) <= 1e-9) || col.y != col.x || col.z != col.x;
             }
@@ -795,10 +795,10 @@ static void test_nff_view(void)
     Ray a, b;
     double angle;
     if (!load_or_fail(&s, f, "NFF: a scene of every entity loads")) return;
-    a = camera_ray(&s.cam, s.w, s.h, 0.5, 24);
-    b = camera_ray(&s.cam, s.w, s.h, 63.5, 24);
+    a = camera_ray(&s.cam, s.set.w, s.set.h, 0.5, 24);
+    b = camera_ray(&s.cam, s.set.w, s.set.h, 63.5, 24);
     angle = acos(dot(a.d, b.d)) * 180 / PI;
-    report(s.w == 64 && s.h == 48 && near(angle, 40, 1e-9),
+    report(s.set.w == 64 && s.set.h == 48 && near(angle, 40, 1e-9),
            "NFF angle spans the outer pixel centres", "%.12g deg, want %g", angle, 40);
     report(s.nlight == 2 && near(s.light[1].color.x, .5 * sqrt(2) / 4, 1e-15)
            && near(s.ambient.x, sqrt(2) / 4, 1e-15),
@@ -889,7 +889,7 @@ static void test_no_nan(void)
         build_accel(&s, "auto");
         for (j = 0; j < W; j++)
             for (i = 0; i < W; i++) {
-                vec c = trace(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), s.depth, 1, &wk);
+                vec c = trace(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), s.set.depth, 1, &wk);
                 bad += !isfinite(c.x) || !isfinite(c.y) || !isfinite(c.z);
                 pixels++;
             }
