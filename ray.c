@@ -412,7 +412,7 @@ typedef struct Bsdf Bsdf;
 static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk);
 static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk);
 static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk);
-static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk);
+static int survives(const Scene *s, int rays, vec *beta, vec *f_cos_pdf, Worker *wk);
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
@@ -427,8 +427,8 @@ static int front_emits(const Scene *s, int i, vec ng, vec wo);
 static void bsdf_at(const Scene *s, const Hit *h, vec wo, Bsdf *b);
 static vec bsdf_eval(const Bsdf *b, vec wo, vec wi);
 static real bsdf_pdf(const Bsdf *b, vec wo, vec wi);
-static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf);
-static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos);
+static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos_pdf, real *pdf);
+static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos_pdf);
 static real fresnel(real cosi, real eta);
 
 /* finding hits: the only code that knows an acceleration structure exists */
@@ -834,7 +834,7 @@ static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk)
 static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Worker *wk)
 {
     const Material *m = &s->mat[h->mat];
-    vec n = h->n, color = s->ambient, spec = v3(0, 0, 0), c, t, mirror, dir;
+    vec n = h->n, color = s->ambient, spec = v3(0, 0, 0), c, refracted, mirror, dir;
     real cosi = -dot(r.d, n), eta = 1 / m->ir, e, kr;
     int i, tir;
     if (dot(r.d, h->ng) > 0) { n = scale(-1, n); cosi = -cosi; eta = m->ir; } /* inside */
@@ -842,7 +842,7 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
     /* Past the critical angle no refracted ray exists.  The card then loses
      * the kt share (its glass goes black there); the SPD's rule, and with
      * `tir reflect` a sphere file's, sends it into the reflected ray. */
-    tir = m->kt > 0 && !refract(r.d, n, cosi, eta, &t);
+    tir = m->kt > 0 && !refract(r.d, n, cosi, eta, &refracted);
     kr = tir && s->tir_reflect ? m->ks + m->kt : m->ks;
     for (i = 0; i < s->nlight; i++)
         if (shadow_ray(s, h, n, &s->light[i], &e, &dir, wk)) {
@@ -866,7 +866,7 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
     }
     if (!tir && worth_tracing(m->kt, weight, depth, wk)) {
         wk->count.refracted++;
-        c = comb(m->kt, trace(s, spawn(s, h, t), depth - 1, m->kt * weight, wk), c);
+        c = comb(m->kt, trace(s, spawn(s, h, refracted), depth - 1, m->kt * weight, wk), c);
     }
     return c;
 }
@@ -1040,36 +1040,35 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
     Hit h;
     Bsdf b;
     Path next;
-    vec wo = scale(-1, r.d), Le, direct, f_cos, Li;
+    vec wo = scale(-1, r.d), emission, direct, wi, f_cos_pdf, Li;
     real pdf;
     int lobe;
     if (!nearest_hit(s, r, &h, wk)) return sky(s, r.d, path);
-    Le = emitted(s, &h, wo, path);
-    if (path->rays == s->set.max_rays || path->rays == MAX_PATH) return Le;
+    emission = emitted(s, &h, wo, path);         /* Le, weighed for the estimator */
+    if (path->rays == s->set.max_rays || path->rays == MAX_PATH) return emission;
     bsdf_at(s, &h, wo, &b);
     /* this hit's block of random numbers; the next hit sets its own, and
      * nothing below draws after radiance() of the next ray returns */
     wk->bounce = path->rays - 1;
     direct = s->set.estimator == BSDF_ONLY ? v3(0, 0, 0) : sample_light(s, &h, &b, wo, wk);
-    lobe = sample_bsdf(&b, wo, wk, &next.from, &f_cos, &pdf);   /* next.from: wi */
-    if (lobe < 0) return add(Le, direct);
-    next.beta = mul(path->beta, f_cos);
-    if (!survives(s, path->rays, &next.beta, &f_cos, wk)) return add(Le, direct);
+    lobe = sample_bsdf(&b, wo, wk, &wi, &f_cos_pdf, &pdf);
+    if (lobe < 0) return add(emission, direct);
+    next.beta = mul(path->beta, f_cos_pdf);
+    if (!survives(s, path->rays, &next.beta, &f_cos_pdf, wk)) return add(emission, direct);
     wk->count.bounced++;
     next.rays = path->rays + 1;
     next.counted = lobe == MIRROR_LOBE || lobe == GLASS_LOBE;
     next.pdf = pdf;
-    r = spawn(s, &h, next.from);
     next.from = h.p;
     next.n_from = b.n;
-    Li = radiance(s, r, &next, wk);
-    return add(add(Le, direct), mul(f_cos, Li));
+    Li = radiance(s, spawn(s, &h, wi), &next, wk);
+    return add(add(emission, direct), mul(f_cos_pdf, Li));
 }
 
 /* Russian roulette: from ROULETTE_FROM rays on, the path goes on with the
  * chance q that its throughput beta suggests (at most 0.95, so that a hall
  * of mirrors ends too), and what it brings back counts 1/q times. */
-static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
+static int survives(const Scene *s, int rays, vec *beta, vec *f_cos_pdf, Worker *wk)
 {
     real q, m = beta->x > beta->y ? beta->x : beta->y;
     if (m < beta->z) m = beta->z;
@@ -1077,7 +1076,7 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos, Worker *wk)
     q = m < (real)0.95 ? m : (real)0.95;
     if (!(bounce_random(wk, ROULETTE) < q)) return 0;
     *beta = scale(1 / q, *beta);
-    *f_cos = scale(1 / q, *f_cos);
+    *f_cos_pdf = scale(1 / q, *f_cos_pdf);
     return 1;
 }
 
@@ -1354,11 +1353,11 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
 }
 
 /* Draws wi from the BSDF: first a lobe, by the chances p, then a
- * direction from it.  *f_cos returns f cos(theta_i) / pdf, the factor the
+ * direction from it.  *f_cos_pdf returns f cos(theta_i) / pdf, the factor the
  * light from wi is multiplied by; *pdf the pdf of wi (for MIS; undefined for
  * a delta lobe).  Returns the lobe, or -1 when the path ends here (the
  * light is absorbed, or the direction fell below the surface). */
-static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, real *pdf)
+static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos_pdf, real *pdf)
 {
     real u = bounce_random(wk, LOBE), cosi = dot(wo, b->n);
     real u1 = bounce_random(wk, DIRECTION_U), u2 = bounce_random(wk, DIRECTION_V);
@@ -1368,20 +1367,20 @@ static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, r
     if (!(b->p[lobe] > 0)) return -1;
     if (lobe == MIRROR_LOBE) {
         *wi = reflect(scale(-1, wo), b->n, cosi);
-        *f_cos = v3(b->mirror / b->p[lobe], b->mirror / b->p[lobe], b->mirror / b->p[lobe]);
+        *f_cos_pdf = v3(b->mirror / b->p[lobe], b->mirror / b->p[lobe], b->mirror / b->p[lobe]);
         return dot(*wi, b->ng) > 0 ? lobe : -1;
     }
-    if (lobe == GLASS_LOBE) return sample_glass(b, wo, u / b->p[lobe], wi, f_cos);
+    if (lobe == GLASS_LOBE) return sample_glass(b, wo, u / b->p[lobe], wi, f_cos_pdf);
     if (lobe == DIFFUSE_LOBE) *wi = from_local(b->n, cosine_hemisphere(u1, u2));
     else *wi = from_local(reflect(scale(-1, wo), b->n, cosi), phong_lobe(b->shine, u1, u2));
     if (b->glossy == 0) {         /* Lambert alone: f cos / pdf is the albedo over its chance */
         *pdf = b->p[DIFFUSE_LOBE] * cosine_hemisphere_pdf(dot(*wi, b->n));
-        *f_cos = scale(1 / b->p[DIFFUSE_LOBE], b->albedo);
+        *f_cos_pdf = scale(1 / b->p[DIFFUSE_LOBE], b->albedo);
         return dot(*wi, b->ng) > 0 && *pdf > 0 ? lobe : -1;
     }
     *pdf = bsdf_pdf(b, wo, *wi);
     if (!(*pdf > 0)) return -1;
-    *f_cos = scale(dot(*wi, b->n) / *pdf, bsdf_eval(b, wo, *wi));
+    *f_cos_pdf = scale(dot(*wi, b->n) / *pdf, bsdf_eval(b, wo, *wi));
     return lobe;
 }
 
@@ -1395,17 +1394,17 @@ static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos, r
  * chosen, it is again uniform and tells nothing of the choice, so it can
  * choose once more, and the choice needs no dimension of its own (the
  * LOBE slot serves both; SPARE stays free). */
-static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos)
+static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos_pdf)
 {
     real cosi = dot(wo, b->n), w = b->glass / b->p[GLASS_LOBE];
     vec d = scale(-1, wo);
     if (u < fresnel(cosi, b->eta) || !refract(d, b->n, cosi, b->eta, wi)) {
         *wi = reflect(d, b->n, cosi);
-        *f_cos = v3(w, w, w);
+        *f_cos_pdf = v3(w, w, w);
         return dot(*wi, b->ng) > 0 ? GLASS_LOBE : -1;
     }
     w *= b->eta * b->eta;
-    *f_cos = v3(w, w, w);
+    *f_cos_pdf = v3(w, w, w);
     return dot(*wi, b->ng) < 0 ? GLASS_LOBE : -1;
 }
 
