@@ -373,18 +373,16 @@ static void box_union(double lo[3], double hi[3], const double lo2[3], const dou
 /* for each pixel */
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
-static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
-static int set_camera(Scene *s, const real *v, char *why);
 static void put_pixel(Image *img, int i, int j, vec c);
-static unsigned char to_byte(real v);
 static real srgb(real v);
+static unsigned char to_byte(real v);
 static vec pixel_view(const Scene *s, int i, int j, Worker *wk);   /* --view, in the plumbing */
 
 /* samples: the points of a pixel, random numbers, the warps and their pdfs */
-static void sample_offset(int k, real anchor, real *dx, real *dy);
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
 static real random01(const Worker *wk, unsigned dim);
 static real bounce_random(const Worker *wk, int slot);
+static void sample_offset(int k, real anchor, real *dx, real *dy);
 static vec from_local(vec n, vec l);
 static vec cosine_hemisphere(real u1, real u2);
 static real cosine_hemisphere_pdf(real cos_theta);
@@ -396,6 +394,10 @@ static vec sphere_cap(real cap, real u1, real u2);
 static real sphere_cap_pdf(real cap);
 static vec uniform_triangle(real u1, real u2);
 static real uniform_triangle_pdf(real area);
+
+/* the camera: the ray R from the eye */
+static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
+static int set_camera(Scene *s, const real *v, char *why);
 
 /* RayTrace(R): Whitted's recursive ray tracing */
 static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
@@ -505,80 +507,6 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
     return scale((real)1 / spp, sum);
 }
 
-/* The primary ray through image point (x, y), in pixels from the top-left
- * corner of the image.  The image plane stands at the distance where the
- * image's width spans the field of view edge to edge; a pixel is one unit. */
-static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
-{
-    real dist = (real)w / 2 / c->tan_half;
-    Ray r;
-    r.o = c->eye;
-    r.skip = -1;
-    r.d = unit(add(add(scale(x - (real)w / 2, c->right),
-                       scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
-    r.tmin = c->hither > 0 ? c->hither / dot(r.d, c->fwd) : 0;
-    return r;
-}
-
-/* The largest |coordinate| of a light or the camera: two points within it
- * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
- * takes between them (to a light, from the eye) stay finite; beyond it, a
- * light would light nothing and an eye see nothing.  3.9e153 in doubles. */
-#define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
-
-static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
-
-/* a times the power of two that brings its largest coordinate into
- * [1/2, 1): the same direction, and exactly the same unit() and cross()
- * bits as a itself, yet no square of it overflows or underflows. */
-static vec pow2_scaled(vec a)
-{
-    int e;
-    real m = maxabs(a);
-    if (!(m > 0) || !isfinite(m)) return a;
-    frexp(m, &e);
-    return v3((real)ldexp(a.x, -e), (real)ldexp(a.y, -e), (real)ldexp(a.z, -e));
-}
-
-/* The narrowest field of view, in degrees, for which the image plane of
- * camera_ray stays near enough to square its distance at 32768 pixels
- * across: 2.8e-148 degrees in doubles. */
-static double narrowest_fov(void)
-{
-    return 2 * atan(16384 / (sqrt(sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 2))
-           * 180 / PI;
-}
-
-/* The camera at eye v[0..2] looking at v[3..5], up towards v[6..8], with a
- * horizontal field of view of v[9] degrees. */
-static int set_camera(Scene *s, const real *v, char *why)
-{
-    Camera *c = &s->cam;
-    vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
-    c->eye = v3(v[0], v[1], v[2]);
-    if (!within_far_limit(c->eye) || !within_far_limit(at)) {
-        sprintf(why, "camera too far out: beyond %.2g, squared distances from the eye overflow",
-                (double)FAR_LIMIT);
-        return 0;
-    }
-    if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
-        return sprintf(why, "camera looks at its own eye"), 0;
-    if (!(v[9] > 0 && v[9] < 180))
-        return sprintf(why, "field of view must be between 0 and 180 degrees"), 0;
-    if (!(v[9] >= narrowest_fov())) {
-        sprintf(why, "field of view too narrow: under %.2g degrees the image plane is so far away"
-                " that its squared distance overflows", narrowest_fov());
-        return 0;
-    }
-    c->tan_half = tan(v[9] * PI / 360);
-    c->fwd = unit(pow2_scaled(sub(at, c->eye)));
-    c->right = cross(c->fwd, up);
-    if (!(dot(c->right, c->right) > 0)) return sprintf(why, "camera up is parallel to its view"), 0;
-    c->right = unit(c->right);
-    c->up = cross(c->right, c->fwd);
-    return 1;
-}
-
 /* The pixel into the image: as floats (for PFM, the radiance itself), or
  * as bytes, through the sRGB curve where the image asks for it. */
 static void put_pixel(Image *img, int i, int j, vec c)
@@ -596,15 +524,6 @@ static void put_pixel(Image *img, int i, int j, vec c)
     img->bytes[at + 2] = to_byte(c.z);
 }
 
-/* Colour in 0..1 to a byte: x255 and round to nearest (as minray's %.0f
- * does), clamped; NaN becomes 0 so that no pixel is ever undefined. */
-static unsigned char to_byte(real v)
-{
-    double x = rint((double)v * 255);
-    if (!(x > 0)) return 0;
-    return x > 255 ? 255 : (unsigned char)x;
-}
-
 /* Linear light to the sRGB transfer curve (IEC 61966-2-1), which image
  * viewers assume a PPM or PNG holds: a straight line near black, then a
  * 1/2.4 power.  A path-traced image always gets it; Whitted's only with
@@ -612,6 +531,15 @@ static unsigned char to_byte(real v)
 static real srgb(real v)
 {
     return v <= (real)0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+}
+
+/* Colour in 0..1 to a byte: x255 and round to nearest (as minray's %.0f
+ * does), clamped; NaN becomes 0 so that no pixel is ever undefined. */
+static unsigned char to_byte(real v)
+{
+    double x = rint((double)v * 255);
+    if (!(x > 0)) return 0;
+    return x > 255 ? 255 : (unsigned char)x;
 }
 
 /* ----------------------------------------------------------------- samples */
@@ -623,20 +551,6 @@ static real srgb(real v)
  * as Nori's warp.h pairs them (Jakob's educational renderer), so that
  * whoever divides by a pdf calls the function that says it, and a test can
  * hold each warp against its pdf (tests/test_pt.c, "warp" checks). */
-
-/* Sample k of n inside a pixel: the R2 low-discrepancy sequence (Roberts,
- * "The unreasonable effectiveness of quasirandom sequences", 2018), which
- * spreads any number of points evenly and needs no random numbers, so every
- * run gives the same bytes.  Sample 0 lies on the anchor: the pixel's centre,
- * or with `pixel corner` its top-left corner, where minray aims. */
-static void sample_offset(int k, real anchor, real *dx, real *dy)
-{
-    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* 1/g, 1/g^2; g^3 = g + 1 */
-    *dx = (real)(anchor + (k * a1 - floor(k * a1)));   /* the fraction: exact */
-    *dy = (real)(anchor + (k * a2 - floor(k * a2)));
-    if (*dx >= anchor + 0.5) *dx -= 1;          /* wrap into [anchor-1/2, anchor+1/2) */
-    if (*dy >= anchor + 0.5) *dy -= 1;
-}
 
 /* Random numbers without a generator's state: the number in dimension d
  * of sample k of pixel p is a hash of (seed, p, k, d).  So a pixel's noise
@@ -706,6 +620,20 @@ static real random01(const Worker *wk, unsigned dim)
 static real bounce_random(const Worker *wk, int slot)
 {
     return random01(wk, DIM_BOUNCE + (unsigned)wk->bounce * BOUNCE_DIMS + (unsigned)slot);
+}
+
+/* Sample k of n inside a pixel: the R2 low-discrepancy sequence (Roberts,
+ * "The unreasonable effectiveness of quasirandom sequences", 2018), which
+ * spreads any number of points evenly and needs no random numbers, so every
+ * run gives the same bytes.  Sample 0 lies on the anchor: the pixel's centre,
+ * or with `pixel corner` its top-left corner, where minray aims. */
+static void sample_offset(int k, real anchor, real *dx, real *dy)
+{
+    const double a1 = 0.7548776662466927, a2 = 0.5698402909980532; /* 1/g, 1/g^2; g^3 = g + 1 */
+    *dx = (real)(anchor + (k * a1 - floor(k * a1)));   /* the fraction: exact */
+    *dy = (real)(anchor + (k * a2 - floor(k * a2)));
+    if (*dx >= anchor + 0.5) *dx -= 1;          /* wrap into [anchor-1/2, anchor+1/2) */
+    if (*dy >= anchor + 0.5) *dy -= 1;
 }
 
 /* The warps below work in a local frame about the z axis; this turns a
@@ -813,6 +741,82 @@ static vec uniform_triangle(real u1, real u2)
 static real uniform_triangle_pdf(real area)
 {
     return 1 / area;
+}
+
+/* -------------------------------------------------------------- the camera */
+
+/* The primary ray through image point (x, y), in pixels from the top-left
+ * corner of the image.  The image plane stands at the distance where the
+ * image's width spans the field of view edge to edge; a pixel is one unit. */
+static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
+{
+    real dist = (real)w / 2 / c->tan_half;
+    Ray r;
+    r.o = c->eye;
+    r.skip = -1;
+    r.d = unit(add(add(scale(x - (real)w / 2, c->right),
+                       scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
+    r.tmin = c->hither > 0 ? c->hither / dot(r.d, c->fwd) : 0;
+    return r;
+}
+
+/* The largest |coordinate| of a light or the camera: two points within it
+ * are less than sqrt(REAL_MAX) apart, so the squared distances the renderer
+ * takes between them (to a light, from the eye) stay finite; beyond it, a
+ * light would light nothing and an eye see nothing.  3.9e153 in doubles. */
+#define FAR_LIMIT sqrt((sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 12)
+
+static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
+
+/* a times the power of two that brings its largest coordinate into
+ * [1/2, 1): the same direction, and exactly the same unit() and cross()
+ * bits as a itself, yet no square of it overflows or underflows. */
+static vec pow2_scaled(vec a)
+{
+    int e;
+    real m = maxabs(a);
+    if (!(m > 0) || !isfinite(m)) return a;
+    frexp(m, &e);
+    return v3((real)ldexp(a.x, -e), (real)ldexp(a.y, -e), (real)ldexp(a.z, -e));
+}
+
+/* The narrowest field of view, in degrees, for which the image plane of
+ * camera_ray stays near enough to square its distance at 32768 pixels
+ * across: 2.8e-148 degrees in doubles. */
+static double narrowest_fov(void)
+{
+    return 2 * atan(16384 / (sqrt(sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX) / 2))
+           * 180 / PI;
+}
+
+/* The camera at eye v[0..2] looking at v[3..5], up towards v[6..8], with a
+ * horizontal field of view of v[9] degrees. */
+static int set_camera(Scene *s, const real *v, char *why)
+{
+    Camera *c = &s->cam;
+    vec at = v3(v[3], v[4], v[5]), up = pow2_scaled(v3(v[6], v[7], v[8]));
+    c->eye = v3(v[0], v[1], v[2]);
+    if (!within_far_limit(c->eye) || !within_far_limit(at)) {
+        sprintf(why, "camera too far out: beyond %.2g, squared distances from the eye overflow",
+                (double)FAR_LIMIT);
+        return 0;
+    }
+    if (!(dot(pow2_scaled(sub(at, c->eye)), pow2_scaled(sub(at, c->eye))) > 0))
+        return sprintf(why, "camera looks at its own eye"), 0;
+    if (!(v[9] > 0 && v[9] < 180))
+        return sprintf(why, "field of view must be between 0 and 180 degrees"), 0;
+    if (!(v[9] >= narrowest_fov())) {
+        sprintf(why, "field of view too narrow: under %.2g degrees the image plane is so far away"
+                " that its squared distance overflows", narrowest_fov());
+        return 0;
+    }
+    c->tan_half = tan(v[9] * PI / 360);
+    c->fwd = unit(pow2_scaled(sub(at, c->eye)));
+    c->right = cross(c->fwd, up);
+    if (!(dot(c->right, c->right) > 0)) return sprintf(why, "camera up is parallel to its view"), 0;
+    c->right = unit(c->right);
+    c->up = cross(c->right, c->fwd);
+    return 1;
 }
 
 /* ------------------------------------------------------------- RayTrace(R) */

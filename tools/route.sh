@@ -8,7 +8,8 @@ set -u
 file=$1; shift
 prev=0 back=0 n=0
 for f in "$@"; do
-  line=$(grep -n -E "^(static )?[A-Za-z_][A-Za-z0-9_ *]*[ *]$f\(" "$file" | grep -v ';' | head -n 1 | cut -d: -f1)
+  # the last line that starts a definition of f: prototypes come first
+  line=$(grep -n -E "^(static )?[A-Za-z_][A-Za-z0-9_ *]*[ *]$f\(" "$file" | grep -v -E '\);$' | tail -n 1 | cut -d: -f1)
   if [ -z "$line" ]; then printf '      %-22s elsewhere\n' "$f"; continue; fi
   n=$((n + 1))
   mark=" "
