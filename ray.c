@@ -1,40 +1,26 @@
 /* ray.c - the lecture "Ray Tracing + Global Illumination" as one C file:
  * Whitted's recursive ray tracer and Kajiya's path tracer side by side,
  * spheres, cones and triangles, and the structures that find hits (kdtree.c,
- * bvh.c, grid.c).
+ * bvh.c, grid.c).  Everything a ray meets is here; reading scenes
+ * (scene.c), writing images (image.c) and the command line (cli.c, whose
+ * `./ray --help` lists the options) live beside it.
  *
  *     make && ./ray -s 640x480 -n 4 scenes/whitted.sph      (writes whitted.ppm)
  *     ./ray scenes/cornell.sph                              (path traced)
  *
- * Usage: ./ray [options] SCENE
- *     -o FILE     output image: PPM, PNG (.png) or PFM floats (.pfm)
- *                 (default: SCENE's base name with .ppm; - = stdout)
- *     -s WxH      image size (default: the scene's, else 512x512)
- *     -n N        samples per pixel (default: the scene's, else 1)
- *     -d N        Whitted: recursion depth, 1 = primary rays only (default:
- *                 scene's, else 5); path tracing: the rays of a path at most
- *     -t N        threads (default: every core, when built with OpenMP)
- *     --pt, --whitted   path tracing or Whitted (default: the scene's, else Whitted)
- *     --estimator E     bsdf, nee or mis (default), for the path tracer
- *     --no-roulette, --seed N     for the path tracer
- *     --gamma     the sRGB curve on Whitted's output (path tracing always has it)
- *     --p3        plain-text PPM (P3) instead of binary (P6)
- *     --accel A   kd (kdtree.c), bvh (bvh.c), grid (grid.c), none (test every
- *                 object), or auto (default: the scene's `accel`, else from 8
- *                 objects on the structure a short probe render finds fastest)
- *     --view V    steps, normal or depth: what a pixel's ray meets, as a picture
- *     --stats     print rays by kind, hits, the tree and time on stderr
- *     --help
- * SCENE is the sphere format (README.md), or an NFF file (Eric Haines'
- * Neutral File Format, as the SPD benchmark scenes come) when it ends .nff.
- *
  * HOW TO READ IT.  The lecture comes first, in the order a ray meets it:
  * the types, the vectors, a table of contents (the prototypes), then
- * "for each pixel", the samples (the points of a pixel, random numbers,
- * and the warps that turn them into points and directions, each with its
- * pdf), RayTrace(R) (Whitted), L = Le + integral f L cos (Kajiya), finding
- * hits, and the primitives.  After the line THE PLUMBING come threads,
- * scene files, output and main(); a student can stop reading there.
+ * "for each pixel", the samples (the points of a pixel, random numbers by
+ * fixed dimension, and the warps that turn them into points and
+ * directions, each with its pdf), the camera, RayTrace(R) (Whitted),
+ * L = Le + integral f L cos (Kajiya), finding hits, and the primitives.
+ * After the line THE PLUMBING come threads and render()'s hooks, --view,
+ * the builder that scene.c fills a Scene through, --stats and main(); a
+ * student can stop reading there.
+ *
+ * Whitted's reader may skip the samples but for sample_offset (the R2
+ * pattern), and all of "L = Le + integral f L cos"; the path tracer's
+ * reader may skip "RayTrace(R)".
  *
  * The lecture's pseudo-code, and the functions that do it:
  *
@@ -61,16 +47,19 @@
  *                                                   sample_bsdf(): f cos / pdf times
  *                                                   Li = radiance() of the next point
  *
- * One primary ray of Whitted's, from main() to its pixel's byte.  Each function is
- * defined below the one before it, except the eight marked ^, which a
- * reader finds further up:
+ * Two routes through the file, function by function.  Each function is
+ * defined below the one before it, except those marked ^, which a reader
+ * finds further up (tools/route.sh counts them).
+ *
+ * One primary ray of Whitted's, from main() to its pixel's byte (7 marked
+ * ^ of 25):
  *
  *       main()            reads the scene, builds the tree          (plumbing)
  *     ^ render()          shares the rows out among threads         (plumbing)
  *     ^ render_row()      for each pixel of a row                   for each pixel
  *       pixel_color()     averages the pixel's samples
  *       sample_offset()   where sample k lies in the pixel          samples
- *     ^ camera_ray()      the ray R from the eye through it         for each pixel
+ *       camera_ray()      the ray R from the eye through it         the camera
  *       trace()           RayTrace(R)                               RayTrace(R)
  *       nearest_hit()     the nearest hit                           finding hits
  *       query()           the record the tree hands back
@@ -91,7 +80,43 @@
  *       (trace() again for the reflected ray, from the top)
  *       refract()         Snell's law, then trace() again
  *     ^ to_byte()         the pixel's colour to a byte              for each pixel
- *       write_ppm()       the image to its file                     (plumbing)
+ *       write_image()     the image to its file                     (image.c)
+ *
+ * One path-traced sample, in the Cornell box (a triangle lit by a
+ * triangle; 14 marked ^ of 45):
+ *
+ *       main(), ^ render(), ^ render_row()                          as above
+ *       pixel_radiance()  the mean of the pixel's samples           Kajiya
+ *       sample_radiance() one camera ray through a random point of the pixel
+ *     ^ start_sample()    the sample's numbers                      samples
+ *       random01()        one number, by its dimension
+ *       sample_offset()   the R2 point, shifted by the pixel's own offset
+ *       camera_ray()      the ray R                                 the camera
+ *       radiance()        L(x, wo)                                  Kajiya
+ *       nearest_hit() ... hit_triangle()   as Whitted's, above      finding hits
+ *     ^ fill_hit(), triangle_surface()                              finding hits
+ *     ^ emitted()         Le, weighed for the estimator             Kajiya
+ *       front_emits()     a one-sided lamp from its front only
+ *       bsdf_at()         the BSDF at the hit
+ *     ^ sample_light()    next-event estimation
+ *     ^ bounce_random()   this bounce's numbers                     samples
+ *       choose_light()    a light, by its power                     Kajiya
+ *       sample_emitter()  a point on it
+ *       triangle_sample() on the lamp's triangle                    the primitives
+ *     ^ uniform_triangle() its warp                                 samples
+ *       triangle_pdf()    and its pdf, in solid angle               the primitives
+ *     ^ light_choice()    the chance it was chosen                  Kajiya
+ *       bsdf_eval()       f there
+ *       spawn(), any_hit(), find_any()    the shadow ray            finding hits
+ *     ^ power_heuristic() MIS's weight                              Kajiya
+ *       bsdf_pdf()        the BSDF's pdf of the light's direction
+ *     ^ cosine_hemisphere_pdf()                                     samples
+ *       sample_bsdf()     the next direction                        Kajiya
+ *     ^ cosine_hemisphere(), uniform_disc()   Malley's method       samples
+ *     ^ from_local()      into the surface's frame
+ *       survives()        Russian roulette                          Kajiya
+ *       (radiance() again for the next ray, from the top)
+ *     ^ put_pixel(), srgb(), to_byte()                              for each pixel
  *
  * Build options: -DREAL=float makes every vector float instead of double
  * (the benchmark compares both); -fopenmp renders rows in parallel.  Output
@@ -2299,11 +2324,12 @@ static int degenerate(vec a, vec b, vec c)
 
 /* =========================================================================
  * THE PLUMBING.  The lecture ends here.  What follows makes it a program:
- * threads and a progress line, reading scenes (the sphere format, OBJ and
- * NFF) into a Scene, writing the image, the command line and main().
+ * the threads and render()'s hooks, --view, the builder through which
+ * scene.c's readers fill a Scene, what --stats prints, and main().  The
+ * files beside this one do the rest: scene.c, image.c, cli.c.
  * ========================================================================= */
 
-/* ---------------------------------------------------- threads and progress */
+/* ------------------------------------------------ threads, render()'s hooks */
 
 typedef struct {
     int spp, threads, progress;
