@@ -67,19 +67,9 @@ cpu() {
   cpu=$(printf '%d.%03d' $((ms / 1000)) $((ms % 1000)))
 }
 
-# The arithmetic and the tables are bench/table.c's, as in bench/run.sh
-# (its subcommands are listed at its top): kv LOG KEY: KEY's value in a log
-# of ./ray --stats=kv; spread V...: "least median greatest" of the values;
-# range FORMAT V...: "least-greatest"; ratios "A..." "B...": the pairs'
-# ratios; ratio FORMAT A B: one; verdict A OP B: "met" or "NOT MET".
-table() { "$OUT/table" "$@"; }
-kv() { table kv "$@"; }
-spread() { table spread "$@"; }
-median() { table median "$@"; }
-range() { table range "$@"; }
-ratios() { table ratios "$@"; }
-ratio() { table ratio "$@"; }
-verdict() { table verdict "$@"; }
+# The arithmetic and the tables are bench/table.c's, as in bench/run.sh;
+# bench/lib.sh names its subcommands.
+. bench/lib.sh
 
 # reference NAME SIZE: MIS at $REF_SPP spp, seed 99 (the runs use seed 0:
 # a reference sharing their random numbers would share their noise).

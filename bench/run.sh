@@ -196,22 +196,8 @@ sum3() {
 }
 
 # The tables' arithmetic, and the reading of our own logs, is bench/table.c's
-# (built below, into $OUT/table; its subcommands are listed at its top):
-# spread V...: "least median greatest" of the values (the median of an even
-# count: the mean of the two in the middle); median V...; range FORMAT V...:
-# "least-greatest", each in FORMAT (printf's); ratios "A1 A2 ..." "B1 B2
-# ...": A1/B1 A2/B2 ..., the pairs' ratios (as many as there are pairs);
-# ratio FORMAT A B: one.
-table() { "$OUT/table" "$@"; }
-spread() { table spread "$@"; }
-median() { table median "$@"; }
-range() { table range "$@"; }
-ratios() { table ratios "$@"; }
-ratio() { table ratio "$@"; }
-# kv LOG KEY: KEY's value in a log of ./ray --stats=kv ("key value" lines),
-# e.g. cpu_s, the render's CPU seconds (every thread; the scene's reading
-# and the structure's build are not in it), or rays, every ray of any kind.
-kv() { table kv "$@"; }
+# (built below, into $OUT/table); bench/lib.sh names its subcommands.
+. bench/lib.sh
 
 for n in $SPPS $REF_SPP; do
   case $n in ''|*[!0-9]*|0) die "sample counts must be whole numbers from 1, not '$n'";; esac
@@ -433,8 +419,6 @@ fi
 # and on whatever else runs on them.
 
 targets=()   # one line per target, printed together at the end
-# verdict A OP B: "met" when A OP B (OP: < <= > >=), else "NOT MET".
-verdict() { table verdict "$@"; }
 num() { [[ ${1:-} =~ ^[0-9]+([.][0-9]*)?([eE][-+]?[0-9]+)?$ ]]; }
 
 # install_pkg PACKAGE: only with BENCH_INSTALL=1, and never fatal: the

@@ -100,6 +100,19 @@ static void ready(Scene *s, int estimator, int roulette, int max_rays)
     settle_path_options(s, PATH, estimator, roulette, 7);
 }
 
+/* The Cornell box at size x size, ready for the path tracer with the given
+ * estimator and roulette; 0 after a FAIL line for the check `name`. */
+static int cornell(Scene *s, int size, int estimator, const char *name)
+{
+    if (!load_scene(s, "scenes/cornell.sph")) {
+        report(0, name, "cannot load scenes/cornell.sph");
+        return 0;
+    }
+    s->set.w = s->set.h = size;
+    ready(s, estimator, 1, 0);
+    return 1;
+}
+
 /* n samples spread over the image, channel c of each. */
 static Stat image_samples(const Scene *s, int n, int c)
 {
@@ -714,12 +727,7 @@ static void test_dimensions_fixed(void)
         Scene s;
         Worker wk = worker();
         int i, j;
-        if (!load_scene(&s, "scenes/cornell.sph")) {
-            report(0, "dimensions: the paths are the same for every estimator", "cannot load scenes/cornell.sph");
-            return;
-        }
-        s.set.w = s.set.h = 32;
-        ready(&s, e, 1, 0);
+        if (!cornell(&s, 32, e, "dimensions: the paths are the same for every estimator")) return;
         for (j = 0; j < s.set.h; j++)
             for (i = 0; i < s.set.w; i++) pixel_radiance(&s, i, j, 4, &wk);
         bounced[e] = wk.count.bounced;
@@ -765,12 +773,7 @@ static void test_estimators_agree(void)
     double worst = 0;
     for (e = 0; e < 3; e++) {
         Worker wk = worker();
-        if (!load_scene(&s[e], "scenes/cornell.sph")) {
-            report(0, "the three estimators agree on the Cornell box", "cannot load scenes/cornell.sph");
-            return;
-        }
-        s[e].set.w = s[e].set.h = 16;
-        ready(&s[e], e, 1, 0);
+        if (!cornell(&s[e], 16, e, "the three estimators agree on the Cornell box")) return;
         memset(st[e], 0, sizeof st[e]);
         for (k = 0; k < 16 * 16 * 384; k++) {
             int pixel = k % 256, i = pixel % 16, j = pixel / 16;
@@ -827,12 +830,7 @@ static void test_seed(void)
     Scene s;
     Stat d = { 0, 0, 0 };
     int i, j, same = 0;
-    if (!load_scene(&s, "scenes/cornell.sph")) {
-        report(0, "another seed", "cannot load scenes/cornell.sph");
-        return;
-    }
-    s.set.w = s.set.h = 24;
-    ready(&s, MIS, 1, 0);
+    if (!cornell(&s, 24, MIS, "another seed")) return;
     for (j = 0; j < s.set.h; j++)
         for (i = 0; i < s.set.w; i++) {
             Worker wk = worker();
