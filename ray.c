@@ -1829,6 +1829,13 @@ static vec near_point(vec o, real t, vec d, vec v)
 
 /* Smallest root t of |o + t d - c| = r with t > tmin, or INFINITY.
  *
+ * The slide's form: with f = o - c, the point is on the sphere where
+ *     (d.d) t^2 + 2 (f.d) t + f.f - r^2 = 0,
+ *     t = (-(f.d) -+ sqrt((f.d)^2 - (d.d)(f.f - r^2))) / (d.d).
+ * The code below finds the same two roots; its extra lines are for
+ * precision only: they keep the roots right when the sphere is far from
+ * the ray's origin or small beside it.
+ *
  * The textbook form b*b - c loses every digit when the sphere is far away or
  * small: both terms are about |o-c|^2 and their difference about r^2.  Here
  * the discriminant is r^2 - |l|^2, where l is the vector from the centre to
