@@ -114,5 +114,9 @@ int main(void)
     printf("    largest error of a pixel's splatted sum: %g\n", worst);
     check(worst < 1e-5, "hooks: each pixel gets exactly what was splatted to it, over the samples");
     free_scene(&s);
+    free_image(&one);
+    free_image(&two);
+    free_image(&three);
+    free_image(&plain);
     return failures != 0;
 }
