@@ -25,7 +25,7 @@
  * The lecture's pseudo-code, and the functions that do it:
  *
  *     for each pixel                        render_row(), pixel_color()
- *         compute the ray R from the eye    camera_ray()
+ *         compute the ray R from the eye    primary_ray(): camera_ray(), through_lens()
  *         pixel colour = RayTrace(R)        trace()
  *
  *     RayTrace(R):                          trace()
@@ -33,9 +33,9 @@
  *           (t, point, object, normal)        fill_hit()
  *         colour = black (or background)
  *         if there is a hit                 shade()
- *             for each light                   shadow_ray()
+ *             for each light                   shadow_ray(); area_lights()
  *                 a ray to the light; does it hit anything?   any_hit()
- *                 if not, add the light's share
+ *                 if not, add the light's share    lit_by()
  *             reflected ray Refl               reflect(); colour += RayTrace(Refl)
  *             refracted ray (Snell)            refract(); colour += RayTrace(Refr)
  *
@@ -52,14 +52,15 @@
  * finds further up (tools/route.sh counts them).
  *
  * One primary ray of Whitted's, from main() to its pixel's byte (7 marked
- * ^ of 25):
+ * ^ of 26):
  *
  *       main()            reads the scene, builds the tree          (plumbing)
  *     ^ render()          shares the rows out among threads         (plumbing)
  *     ^ render_row()      for each pixel of a row                   for each pixel
  *       pixel_color()     averages the pixel's samples
  *       sample_offset()   where sample k lies in the pixel          samples
- *       camera_ray()      the ray R from the eye through it         the camera
+ *       primary_ray()     the ray R from the eye through it         the camera
+ *       camera_ray()      (through_lens() for a lens)
  *       trace()           RayTrace(R)                               RayTrace(R)
  *       nearest_hit()     the nearest hit                           finding hits
  *       query()           the record the tree hands back
@@ -73,6 +74,7 @@
  *     ^ shade()           the light at the hit                      RayTrace(R)
  *       reflect()         the mirror direction (for the highlight)
  *     ^ shadow_ray()      towards each light
+ *       (lit_by(), area_lights() for a glowing sphere or triangle)
  *       spawn()           the ray leaves the surface                finding hits
  *       any_hit()         is anything in the way?
  *       find_any()        asks the tree, or every object
@@ -83,7 +85,7 @@
  *       write_image()     the image to its file                     (image.c)
  *
  * One path-traced sample, in the Cornell box (a triangle lit by a
- * triangle; 14 marked ^ of 45):
+ * triangle; 15 marked ^ of 47):
  *
  *       main(), ^ render(), ^ render_row()                          as above
  *       pixel_radiance()  the mean of the pixel's samples           Kajiya
@@ -91,7 +93,7 @@
  *     ^ start_sample()    the sample's numbers                      samples
  *       random01()        one number, by its dimension
  *       sample_offset()   the R2 point, shifted by the pixel's own offset
- *       camera_ray()      the ray R                                 the camera
+ *       primary_ray(), camera_ray()   the ray R                     the camera
  *       radiance()        L(x, wo)                                  Kajiya
  *       nearest_hit() ... hit_triangle()   as Whitted's, above      finding hits
  *     ^ fill_hit(), triangle_surface()                              finding hits
@@ -107,7 +109,8 @@
  *       triangle_pdf()    and its pdf, in solid angle               the primitives
  *     ^ light_choice()    the chance it was chosen                  Kajiya
  *       bsdf_eval()       f there
- *       spawn(), any_hit(), find_any()    the shadow ray            finding hits
+ *     ^ light_visible()   the shadow ray: is the light seen?
+ *       spawn(), any_hit(), find_any()                              finding hits
  *     ^ power_heuristic() MIS's weight                              Kajiya
  *       bsdf_pdf()        the BSDF's pdf of the light's direction
  *     ^ cosine_hemisphere_pdf()                                     samples
@@ -164,8 +167,9 @@ typedef struct { real x, y, z; } vec;
 /* minray's material: diffuse, mirror, transmitted and emitted weights, and
  * the index of refraction inside (the ray bends by 1/ir going in, by ir
  * coming out).  shine > 0 adds a Phong highlight (NFF's materials have one;
- * minray's spheres do not). */
-typedef struct { vec color; real kd, ks, kt, kl, ir, shine; } Material;
+ * minray's spheres do not); with spread (the sphere format's `glossy`)
+ * Whitted's mirror ray spreads into the same lobe. */
+typedef struct { vec color; real kd, ks, kt, kl, ir, shine; int spread; } Material;
 
 typedef struct { vec cen; real rad; int mat; } Sphere;
 
@@ -196,6 +200,8 @@ typedef struct {
     real tan_half;            /* tan(fov / 2); fov: horizontal, edge to edge */
     real anchor;              /* 0.5: samples centred on the pixel; 0: on its corner */
     real hither;              /* near clip: nothing nearer than this plane is seen */
+    real lens, focus;         /* a thin lens: its radius (0: a pinhole), and the distance
+                               * of the plane it brings into focus */
 } Camera;
 
 /* A light as the path tracer samples it (sample_light): a point light, an
@@ -256,7 +262,10 @@ typedef struct {
     Camera cam;
     vec ambient, background;
     int tir_reflect;          /* Whitted: past the critical angle kt goes to the mirror */
+    int lights_centre;        /* Whitted: glowing spheres light from their centres (the card's) */
+    int shadow_rays;          /* Whitted: shadow rays to each area light, a sample */
     int cull;                 /* while reading: `sided 1` for the triangles still to come */
+    real glossy;              /* while reading: `glossy S` for the materials still to come */
     char warning[256];        /* said once when the path tracer starts, if set */
     char whitted_warning[256];  /* the same for Whitted's */
     Settings set;
@@ -421,12 +430,20 @@ static vec uniform_triangle(real u1, real u2);
 static real uniform_triangle_pdf(real area);
 
 /* the camera: the ray R from the eye */
+static Ray primary_ray(const Scene *s, real x, real y, const Worker *wk);
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y);
+static real near_clip(const Camera *c, vec d);
+static Ray through_lens(const Camera *c, Ray r, real u1, real u2);
 static int set_camera(Scene *s, const real *v, char *why);
 
 /* RayTrace(R): Whitted's recursive ray tracing */
 static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
 static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Worker *wk);
+static void lit_by(const Material *m, vec light, real e, vec dir, vec mirror, vec *color,
+                   vec *spec);
+static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker *wk);
+static void area_point(const Worker *wk, int l, int q, real *u, real *v);
+static vec glossy_mirror(vec mirror, real shine, const Worker *wk);
 static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real *e,
                       vec *to_light, Worker *wk);
 static int worth_tracing(real k, real weight, int depth, Worker *wk);
@@ -447,8 +464,9 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
 static void prepare_lights(Scene *s);
 static int choose_light(const Scene *s, real u);
 static real light_choice(const Scene *s, int l);
-static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *wi,
+static int sample_emitter(const Scene *s, int l, vec x, vec n, real u, real v, vec *wi,
                           real *dist, vec *Le, real *pdf);
+static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist, Worker *wk);
 static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny);
 static int front_emits(const Scene *s, int i, vec ng, vec wo);
 static void bsdf_at(const Scene *s, const Hit *h, vec wo, Bsdf *b);
@@ -524,9 +542,10 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
     for (k = 0; k < spp; k++) {
         real dx, dy;
         sample_offset(k, s->cam.anchor, &dx, &dy);
+        start_sample(wk, s, i, j, k);       /* for a lens, area lights, a glossy lobe */
         wk->count.primary++;
         wk->budget = RAY_BUDGET;
-        sum = add(sum, trace(s, camera_ray(&s->cam, s->set.w, s->set.h, i + dx, j + dy), s->set.depth, 1, wk));
+        sum = add(sum, trace(s, primary_ray(s, i + dx, j + dy, wk), s->set.depth, 1, wk));
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
     return scale((real)1 / spp, sum);
@@ -605,21 +624,25 @@ static unsigned long long mix64(unsigned long long z)
  *     dimension             what it chooses                   drawn by
  *     DIM_PIXEL_X, _Y       the pixel's shift of its samples  sample_radiance, once a
  *                           (Cranley-Patterson)                 pixel (as its sample -1)
- *     DIM_LENS_U, _V        a point of the lens               reserved: no lens yet
+ *     DIM_LENS_U, _V        a point of the lens               primary_ray (both renderers)
  *     DIM_TIME              an instant of the shutter         reserved: no motion yet
  *   and from DIM_BOUNCE on, a block of BOUNCE_DIMS for each bounce b (0 at the
  *   first hit), slot k of it dimension DIM_BOUNCE + b * BOUNCE_DIMS + k:
  *       LIGHT_CHOICE        which light                       sample_light
- *       LIGHT_U, LIGHT_V    the point on it                   sample_emitter
+ *       LIGHT_U, LIGHT_V    the point on it                   sample_light; Whitted's
+ *                                                               area_point
  *       LOBE                which lobe of the BSDF, and       sample_bsdf
  *                           glass's reflect or refract          (see sample_glass)
- *       DIRECTION_U, _V     the direction within the lobe     sample_bsdf
+ *       DIRECTION_U, _V     the direction within the lobe     sample_bsdf; Whitted's
+ *                                                               glossy_mirror
  *       ROULETTE            whether the path goes on          survives
  *       SPARE               none yet: room for one more
  *
- * The lens and time dimensions are kept now, unused, so that a thin lens
- * or motion blur added later takes its numbers from them and moves no
- * other path's. */
+ * Whitted's renderer draws from the same table where it spreads a ray
+ * (Cook's distributed ray tracing), its recursion level standing for the
+ * bounce.  The time dimension is kept, unused, so that motion blur added
+ * later takes its numbers from it and moves no other path's, as the lens
+ * moved none when it came. */
 enum { DIM_PIXEL_X, DIM_PIXEL_Y, DIM_LENS_U, DIM_LENS_V, DIM_TIME, DIM_BOUNCE };
 enum { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE, SPARE,
        BOUNCE_DIMS };
@@ -707,7 +730,7 @@ static real phong_lobe_pdf(real shine, real cos_alpha)
 }
 
 /* A uniform point (x, y, 0) of the unit disc, for cosine_hemisphere and
- * one day a thin lens: the concentric map of Shirley and Chiu ("A Low Distortion Map Between Disk
+ * the thin lens (through_lens): the concentric map of Shirley and Chiu ("A Low Distortion Map Between Disk
  * and Square", JGT 2(3), 1997), which sends the square's concentric
  * squares to the disc's concentric circles, so that points spread evenly
  * over the square stay spread evenly over the disc (the polar map
@@ -770,9 +793,19 @@ static real uniform_triangle_pdf(real area)
 
 /* -------------------------------------------------------------- the camera */
 
-/* The primary ray through image point (x, y), in pixels from the top-left
- * corner of the image.  The image plane stands at the distance where the
- * image's width spans the field of view edge to edge; a pixel is one unit. */
+/* The primary ray of the sample the worker is at, through image point
+ * (x, y): a pinhole camera's, or with a lens one from a point of it. */
+static Ray primary_ray(const Scene *s, real x, real y, const Worker *wk)
+{
+    Ray r = camera_ray(&s->cam, s->set.w, s->set.h, x, y);
+    if (s->cam.lens > 0) r = through_lens(&s->cam, r, random01(wk, DIM_LENS_U), random01(wk, DIM_LENS_V));
+    return r;
+}
+
+/* The pinhole camera's ray through image point (x, y), in pixels from the
+ * top-left corner of the image.  The image plane stands at the distance
+ * where the image's width spans the field of view edge to edge; a pixel is
+ * one unit. */
 static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
 {
     real dist = (real)w / 2 / c->tan_half;
@@ -781,7 +814,36 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
     r.skip = -1;
     r.d = unit(add(add(scale(x - (real)w / 2, c->right),
                        scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
-    r.tmin = c->hither > 0 ? c->hither / dot(r.d, c->fwd) : 0;
+    r.tmin = near_clip(c, r.d);
+    return r;
+}
+
+/* Where a ray from the eye's plane along d meets the near clip (hither),
+ * as its t; 0 without one. */
+static real near_clip(const Camera *c, vec d)
+{
+    return c->hither > 0 ? c->hither / dot(d, c->fwd) : 0;
+}
+
+/* A thin lens (Potmesil and Chakravarty, "A lens and aperture camera model
+ * for synthetic image generation", SIGGRAPH 1981; sampled over its disc
+ * as Cook, Porter and Carpenter's "Distributed ray tracing", SIGGRAPH
+ * 1984, spreads every effect over one more dimension).  A lens sends all
+ * the light from a point of the plane of focus to one point of the image,
+ * so every ray through the lens that reaches the pinhole ray's image point
+ * crosses the plane of focus where the pinhole ray r does: the ray from a
+ * uniform point of the lens's disc (from u1, u2) towards that point.  A
+ * point at distance z (along the view) is seen from the whole disc of
+ * diameter A = 2 lens, through points of the plane of focus that fill a
+ * disc of diameter A |z - focus| / z, its circle of confusion: sharp on
+ * the plane, blurred before and behind it. */
+static Ray through_lens(const Camera *c, Ray r, real u1, real u2)
+{
+    vec p = uniform_disc(u1, u2);
+    vec sharp = comb(c->focus / dot(r.d, c->fwd), r.d, r.o);     /* on the plane of focus */
+    r.o = add(c->eye, add(scale(c->lens * p.x, c->right), scale(c->lens * p.y, c->up)));
+    r.d = unit(sub(sharp, r.o));
+    r.tmin = near_clip(c, r.d);             /* the lens lies in the eye's plane */
     return r;
 }
 
@@ -859,7 +921,9 @@ static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk)
 
 /* Local light, then reflection and refraction by recursion: minray's model,
  * plus a Phong highlight for materials that have one.  The sums run in the
- * card's order so that the rounding is the card's too. */
+ * card's order so that the rounding is the card's too.  Point lights, and
+ * with the card's rule (`lights centre`) glowing spheres, light by one
+ * shadow ray each; glowing spheres and triangles otherwise by their area. */
 static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Worker *wk)
 {
     const Material *m = &s->mat[h->mat];
@@ -868,36 +932,105 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
     int i, tir;
     if (dot(r.d, h->ng) > 0) { n = scale(-1, n); cosi = -cosi; eta = m->ir; } /* inside */
     mirror = reflect(r.d, n, cosi);
+    wk->bounce = s->set.depth - depth;      /* this level's numbers (see the samples) */
     /* Past the critical angle no refracted ray exists.  The card then loses
      * the kt share (its glass goes black there); the SPD's rule, and with
      * `tir reflect` a sphere file's, sends it into the reflected ray. */
     tir = m->kt > 0 && !refract(r.d, n, cosi, eta, &refracted);
     kr = tir && s->tir_reflect ? m->ks + m->kt : m->ks;
     for (i = 0; i < s->nlight; i++)
-        if (shadow_ray(s, h, n, &s->light[i], &e, &dir, wk)) {
-            color = comb(e, s->light[i].color, color);
-            /* Phong (1975): the mirror direction against the light's.  Not
-             * for ks = 0, where it adds nothing (and pow() of a huge shine,
-             * such as the SPD floor's 100000, underflows slowly). */
-            if (m->shine > 0 && m->ks > 0) {
-                real rl = dot(mirror, dir);
-                if (rl > 0) spec = comb(pow(rl, m->shine), s->light[i].color, spec);
-            }
-        }
+        if ((s->light[i].sphere < 0 || s->lights_centre)
+            && shadow_ray(s, h, n, &s->light[i], &e, &dir, wk))
+            lit_by(m, s->light[i].color, e, dir, mirror, &color, &spec);
+    if (m->kd > 0) area_lights(s, h, n, &color, wk);     /* (only kd sees them) */
     color = mul(color, m->color);
 
     c = scale(m->kl, m->color);                 /* emission */
     c = comb(m->kd, color, c);                  /* diffuse */
     if (m->shine > 0) c = comb(m->ks, spec, c); /* highlight */
-    if (worth_tracing(kr, weight, depth, wk)) {
+    dir = m->spread ? glossy_mirror(mirror, m->shine, wk) : mirror;
+    if ((!m->spread || dot(dir, h->ng) * dot(mirror, h->ng) > 0)     /* a glossy ray may fall */
+        && worth_tracing(kr, weight, depth, wk)) {                  /* behind: it is lost */
         wk->count.reflected++;
-        c = comb(kr, trace(s, spawn(s, h, mirror), depth - 1, kr * weight, wk), c);
+        c = comb(kr, trace(s, spawn(s, h, dir), depth - 1, kr * weight, wk), c);
     }
     if (!tir && worth_tracing(m->kt, weight, depth, wk)) {
         wk->count.refracted++;
         c = comb(m->kt, trace(s, spawn(s, h, refracted), depth - 1, m->kt * weight, wk), c);
     }
     return c;
+}
+
+/* A light's share at the hit: e (its strength there, with the cosine) times
+ * its colour, to the diffuse sum; and for a material with a highlight,
+ * Phong's (1975) cos^shine of the angle between the mirror direction and
+ * the light's.  Not for ks = 0, where it adds nothing (and pow() of a huge
+ * shine, such as the SPD floor's 100000, underflows slowly). */
+static void lit_by(const Material *m, vec light, real e, vec dir, vec mirror, vec *color,
+                   vec *spec)
+{
+    *color = comb(e, light, *color);
+    if (m->shine > 0 && m->ks > 0) {
+        real rl = dot(mirror, dir);
+        if (rl > 0) *spec = comb(pow(rl, m->shine), light, *spec);
+    }
+}
+
+/* Area lights and soft shadows (Cook, Porter and Carpenter, "Distributed
+ * ray tracing", SIGGRAPH 1984: a penumbra is the light's area taken as one
+ * more dimension to spread shadow rays over).  Each glowing sphere and
+ * triangle gets shadow_rays shadow rays a sample, to points the path
+ * tracer would choose (sample_emitter: a sphere by the solid angle it
+ * fills, a triangle by its area), and each point seen counts as a point
+ * light of colour Le / (pi pdf shadow_rays).  kd times the sum is then
+ * what the Lambertian BRDF kd C / pi reflects of the light, an estimate of
+ * the integral of Le cos over the light: Whitted's direct light and the
+ * path tracer's agree (a test holds them together).  No Phong highlight:
+ * a highlight is the reflection of a light no ray can see, a point; the
+ * mirror ray sees an area light as it sees any glowing object. */
+static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker *wk)
+{
+    vec wi, Le;
+    real u, v, dist, pdf, e;
+    int l, q;
+    for (l = 0; l < s->lights.nemit; l++) {
+        const Emitter *em = &s->lights.emit[l];
+        if (em->type != TRIANGLE_LIGHT && (em->type != SPHERE_LIGHT || s->lights_centre)) continue;
+        if (em->obj == h->obj) continue;        /* a sphere or a flat triangle lights not itself */
+        for (q = 0; q < s->shadow_rays; q++) {
+            area_point(wk, l, q, &u, &v);
+            sample_emitter(s, l, h->p, n, u, v, &wi, &dist, &Le, &pdf);
+            e = dot(n, wi);
+            if (!(pdf > 0) || !(e > 0)) continue;   /* facing away: no ray */
+            if (!light_visible(s, h, l, wi, dist, wk)) continue;
+            *color = comb(e / ((real)PI * pdf * s->shadow_rays), Le, *color);
+        }
+    }
+}
+
+/* The numbers of shadow ray q towards light l: the R2 points of
+ * sample_offset, which spread any number of rays evenly over the light,
+ * shifted by this level's random offset (Cranley-Patterson, as the path
+ * tracer's pixels are) and by a fraction of its own for each light, so
+ * that no two lights cast the same pattern. */
+static void area_point(const Worker *wk, int l, int q, real *u, real *v)
+{
+    real dx, dy;
+    sample_offset(q, (real)0.5, &dx, &dy);
+    *u = dx + bounce_random(wk, LIGHT_U) + (real)0.6180339887498949 * l;
+    *v = dy + bounce_random(wk, LIGHT_V) + (real)0.3819660112501051 * l;
+    *u -= floor(*u);
+    *v -= floor(*v);
+}
+
+/* Glossy reflection: the mirror ray spread into the Phong lobe about the
+ * mirror direction, drawn as the path tracer draws its glossy lobe, from
+ * this level's direction numbers.  Its weight stays the mirror's, ks, so
+ * that as shine grows it becomes the mirror ray. */
+static vec glossy_mirror(vec mirror, real shine, const Worker *wk)
+{
+    return from_local(mirror, phong_lobe(shine, bounce_random(wk, DIRECTION_U),
+                                         bounce_random(wk, DIRECTION_V)));
 }
 
 /* The lecture's shadow ray: is light l seen from the hit point?  *e returns
@@ -1059,7 +1192,7 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     path.beta = v3(1, 1, 1);
     path.rays = 1;
     path.counted = 1;
-    return radiance(s, camera_ray(&s->cam, s->set.w, s->set.h, i + dx, j + dy), &path, wk);
+    return radiance(s, primary_ray(s, i + dx, j + dy, wk), &path, wk);
 }
 
 /* L(x, wo) = Le(x, wo) + integral f Li cos, for the ray r arriving at x:
@@ -1156,21 +1289,28 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
     vec wi, Le, f;
     real dist, pdf, cosi;
     int l = choose_light(s, bounce_random(wk, LIGHT_CHOICE)), delta;
-    Ray r;
     if (l < 0) return v3(0, 0, 0);
-    delta = sample_emitter(s, l, h->p, b->n, wk, &wi, &dist, &Le, &pdf);
+    delta = sample_emitter(s, l, h->p, b->n, bounce_random(wk, LIGHT_U), bounce_random(wk, LIGHT_V),
+                           &wi, &dist, &Le, &pdf);
     if (!(pdf > 0)) return v3(0, 0, 0);
     pdf *= light_choice(s, l);
     cosi = dot(wi, b->n);
     f = bsdf_eval(b, wo, wi);
     if (!(cosi > 0) || (f.x == 0 && f.y == 0 && f.z == 0)) return v3(0, 0, 0);
-    wk->count.shadow++;
-    r = spawn(s, h, wi);
-    if (s->lights.emit[l].type == SPHERE_LIGHT || s->lights.emit[l].type == TRIANGLE_LIGHT)
-        r.skip = s->lights.emit[l].obj;          /* the light itself does not block */
-    if (any_hit(s, r, dist, &wk->blocker[l % SHADOW_SLOTS], wk)) return v3(0, 0, 0);
+    if (!light_visible(s, h, l, wi, dist, wk)) return v3(0, 0, 0);
     if (!delta && s->set.estimator == MIS) pdf /= power_heuristic(pdf, bsdf_pdf(b, wo, wi));
     return scale(cosi / pdf, mul(f, Le));
+}
+
+/* The shadow ray towards light l, along wi to the distance dist: does
+ * nothing lie between?  The light itself does not block. */
+static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist, Worker *wk)
+{
+    Ray r = spawn(s, h, wi);
+    wk->count.shadow++;
+    if (s->lights.emit[l].type == SPHERE_LIGHT || s->lights.emit[l].type == TRIANGLE_LIGHT)
+        r.skip = s->lights.emit[l].obj;
+    return !any_hit(s, r, dist, &wk->blocker[l % SHADOW_SLOTS], wk);
 }
 
 /* Luminance of a linear sRGB colour (ITU-R BT.709 weights). */
@@ -1202,6 +1342,9 @@ static void prepare_lights(Scene *s)
     double total = 0;
     int i, k, n = nobj(s);
     size_t most = (size_t)s->nlight + n + 1;      /* point lights, objects, the sky */
+    free(s->lights.emitter);                       /* made again, if made before */
+    free(s->lights.emit);
+    free(s->lights.emit_cdf);
     s->lights.emitter = malloc(((size_t)n + 1) * sizeof *s->lights.emitter);
     s->lights.emit = malloc(most * sizeof *s->lights.emit);
     s->lights.emit_cdf = malloc(most * sizeof *s->lights.emit_cdf);
@@ -1256,16 +1399,16 @@ static real light_choice(const Scene *s, int l)
     return s->lights.emit_cdf[l] - (l > 0 ? s->lights.emit_cdf[l - 1] : 0);
 }
 
-/* A direction wi from x towards a point of light l, the distance dist to
- * that point (INFINITY for the sky), the radiance Le it sends back along
- * -wi, and the pdf of wi in solid angle.  Returns 1 for a point light,
- * which only this can find (its pdf is the choice alone). */
-static int sample_emitter(const Scene *s, int l, vec x, vec n, Worker *wk, vec *wi,
+/* A direction wi from x towards a point of light l chosen by the numbers
+ * u and v, the distance dist to that point (INFINITY for the sky), the
+ * radiance Le it sends back along -wi, and the pdf of wi in solid angle.
+ * Returns 1 for a point light, which only this can find (its pdf is the
+ * choice alone). */
+static int sample_emitter(const Scene *s, int l, vec x, vec n, real u, real v, vec *wi,
                           real *dist, vec *Le, real *pdf)
 {
     const Emitter *e = &s->lights.emit[l];
     const Material *m;
-    real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V);
     vec y, ny;
     int k;
     *pdf = 0;
@@ -2609,6 +2752,11 @@ static int build_material(void *user, const scene_material *m, char *why)
     k.color = vec_of(m->color);
     k.kd = (real)m->kd; k.ks = (real)m->ks; k.kt = (real)m->kt; k.kl = (real)m->kl;
     k.ir = (real)m->ir; k.shine = (real)m->shine;
+    k.spread = 0;
+    if (k.shine == 0 && ((Scene *)user)->glossy > 0) {     /* `glossy S` in a sphere file */
+        k.shine = ((Scene *)user)->glossy;
+        k.spread = 1;
+    }
     return add_material(user, k);
 }
 
@@ -2666,6 +2814,10 @@ static void build_setting(void *user, int what, const double *v, const char *wor
         for (i = 0; i < s->nlight; i++) s->light[i].color = scale((real)v[0], s->light[i].color);
         break;
     case SET_ACCEL: s->set.accel_line = word; break;
+    case SET_LENS: s->cam.lens = (real)v[0]; s->cam.focus = (real)v[1]; break;
+    case SET_LIGHTS_CENTRE: s->lights_centre = v[0] != 0; break;
+    case SET_SHADOW_RAYS: s->shadow_rays = (int)v[0]; break;
+    case SET_GLOSSY: s->glossy = (real)v[0]; break;
     }
 }
 
@@ -2697,6 +2849,7 @@ static void default_scene(Scene *s)
     s->set.w = s->set.h = 512;
     s->set.depth = 5;
     s->cam.anchor = (real)0.5;
+    s->shadow_rays = 1;
     s->set.integrator = WHITTED;
     s->set.estimator = MIS;
     s->set.roulette = 1;
@@ -2772,13 +2925,13 @@ static int settle_path_options(Scene *s, int integrator, int estimator, int roul
     if (estimator >= 0) s->set.estimator = estimator;
     if (seed >= 0) s->set.seed = (unsigned)seed;
     s->set.roulette = roulette;
+    prepare_lights(s);                      /* Whitted's area lights are the path tracer's */
     if (s->set.integrator != PATH) return 1;
     if (!roulette && !s->set.max_rays) {
         fprintf(stderr, "ray: --no-roulette needs -d N (or the scene's `depth`): without either,"
                 " paths would not end\n");
         return 0;
     }
-    prepare_lights(s);
     return 1;
 }
 

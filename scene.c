@@ -525,7 +525,18 @@ static const struct { const char *key, *yes, *no, *expect; int what; } pairs[] =
     { "integrator", "path", "whitted", "expected `integrator path` or `integrator whitted`",
       SET_PATH },
     { "pixel", "corner", "centre", "expected `pixel corner` or `pixel centre`", SET_PIXEL_CORNER },
-    { "sided", "1", "2", "expected `sided 1` (front faces only) or `sided 2`", SET_ONE_SIDED }
+    { "sided", "1", "2", "expected `sided 1` (front faces only) or `sided 2`", SET_ONE_SIDED },
+    { "lights", "centre", "area", "expected `lights centre` (minray's: a glowing sphere lights from"
+      " its centre) or `lights area`", SET_LIGHTS_CENTRE }
+};
+
+/* The keywords that take one number, and the numbers each allows. */
+static const struct { const char *key; double lo, hi; int whole; const char *rule; int what; } ones[] = {
+    { "depth", 1, 64, 1, "depth must be a whole number from 1 to 64", SET_DEPTH },
+    { "samples", 1, 1 << 20, 1, "samples must be a whole number from 1 to 1048576", SET_SAMPLES },
+    { "hither", 0, HUGE_VAL, 0, "hither must be 0 or more", SET_HITHER },
+    { "shadow", 1, 4096, 1, "shadow rays must be a whole number from 1 to 4096", SET_SHADOW_RAYS },
+    { "glossy", 0, 1e6, 0, "glossy exponent must be from 0 to 1e6", SET_GLOSSY }
 };
 
 /* A keyword line: ray.c's extensions to minray's format. */
@@ -546,26 +557,22 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
         set(b, SET_SIZE, size[0], size[1], 0);
         return 1;
     }
-    if (!strcmp(k, "depth")) {
-        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 1 && v[0] <= 64 && v[0] == floor(v[0])))
-            return fail(w, "depth must be a whole number from 1 to 64", tok[1]);
-        set(b, SET_DEPTH, v[0], 0, 0);
+    if (!strcmp(k, "lens")) {
+        if (!numbers(w, k, tok, ntok, 1, 2, v)) return 0;
+        if (!(v[0] >= 0 && v[0] <= 1e30)) return fail(w, "lens radius must be from 0 to 1e30", tok[1]);
+        if (!(v[1] > 0 && v[1] <= 1e30))
+            return fail(w, "focus distance must be positive, at most 1e30", tok[2]);
+        set(b, SET_LENS, v[0], v[1], 0);
         return 1;
     }
-    if (!strcmp(k, "samples")) {
-        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 1 && v[0] <= 1 << 20 && v[0] == floor(v[0])))
-            return fail(w, "samples must be a whole number from 1 to 1048576", tok[1]);
-        set(b, SET_SAMPLES, v[0], 0, 0);
-        return 1;
-    }
-    if (!strcmp(k, "hither")) {
-        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
-        if (!(v[0] >= 0)) return fail(w, "hither must be 0 or more", tok[1]);
-        set(b, SET_HITHER, v[0], 0, 0);
-        return 1;
-    }
+    for (i = 0; i < (int)(sizeof ones / sizeof *ones); i++)
+        if (!strcmp(k, ones[i].key)) {
+            if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
+            if (!(v[0] >= ones[i].lo && v[0] <= ones[i].hi && (!ones[i].whole || v[0] == floor(v[0]))))
+                return fail(w, ones[i].rule, tok[1]);
+            set(b, ones[i].what, v[0], 0, 0);
+            return 1;
+        }
     if (!strcmp(k, "ambient") || !strcmp(k, "background")) {
         if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
         set(b, k[0] == 'a' ? SET_AMBIENT : SET_BACKGROUND, v[0], v[1], v[2]);

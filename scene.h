@@ -36,7 +36,13 @@ enum {
     SET_PIXEL_CORNER,   /* v[0]: 1 samples start on a pixel's corner, 0 on its centre */
     SET_ONE_SIDED,      /* v[0]: 1 the triangles still to come are seen from the front only */
     SET_LIGHT_SCALE,    /* v[0]: every light read so far is scaled by it (NFF's rule) */
-    SET_ACCEL           /* word: kd, bvh, grid, none or auto (from accel_name) */
+    SET_ACCEL,          /* word: kd, bvh, grid, none or auto (from accel_name) */
+    SET_LENS,           /* v[0]: a thin lens's radius (0: a pinhole), v[1]: the distance in focus */
+    SET_LIGHTS_CENTRE,  /* v[0]: 1 Whitted's glowing spheres light from their centres (minray's
+                         * rule), 0 from their whole surface (area lights) */
+    SET_SHADOW_RAYS,    /* v[0]: Whitted's shadow rays to each area light, a sample */
+    SET_GLOSSY          /* v[0]: the Phong exponent of the materials still to come (0: none);
+                         * Whitted's mirror ray spreads into its lobe */
 };
 
 /* What a renderer offers the readers.  Indices count from 0 in the order

@@ -41,6 +41,7 @@
 #define MAX_LIGHTS 16
 #define SIZE 8
 #define DEPTH 4
+#define SHADOW_RAYS 4       /* Whitted's shadow rays to each area light, at most */
 #define PATH_RAYS 8
 
 static char dir[64];
@@ -230,8 +231,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     check_nan = in_range;
     compare = in_range;
 
-    /* Whitted's, through the loop and through each structure */
+    /* Whitted's, through the loop and through each structure, with its
+     * area lights (the path tracer's, made again below) */
     s.set.integrator = WHITTED;
+    if (s.shadow_rays > SHADOW_RAYS) s.shadow_rays = SHADOW_RAYS;
+    prepare_lights(&s);
     if (!build_accel(&s, "none")) abort();
     render_tiny(&s, &loop, "Whitted, loop", check_nan);
     for (a = 0; a < 3 && float_range(&s); a++) {

@@ -10,23 +10,9 @@
 #define main ray_main
 #include "../ray.c"
 #undef main
-#include <stdarg.h>
+#include "report.h"
 
 #define K 4.0
-
-static int failures;
-
-static void report(int ok, const char *name, const char *fmt, ...)
-{
-    va_list ap;
-    printf("%s %s (", ok ? "PASS" : "FAIL", name);
-    va_start(ap, fmt);
-    vprintf(fmt, ap);
-    va_end(ap);
-    printf(")\n");
-    fflush(stdout);
-    failures += !ok;
-}
 
 /* Running mean and variance of one channel's samples. */
 typedef struct { double n, sum, sum2; } Stat;
@@ -78,6 +64,7 @@ static int material(Scene *s, vec color, double kd, double ks, double kt, double
                     double shine)
 {
     Material m;
+    memset(&m, 0, sizeof m);
     m.color = color;
     m.kd = kd; m.ks = ks; m.kt = kt; m.kl = kl; m.ir = ir; m.shine = shine;
     return add_material(s, m);
