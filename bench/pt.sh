@@ -46,30 +46,12 @@ mkdir -p "$OUT"
 die() { echo "bench/pt.sh: $*" >&2; exit 1; }
 say() { echo "bench: $*" >&2; }
 
-OMP=$(echo 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
-# shellcheck disable=SC2086
-$CC $CFLAGS $OMP -o "$OUT/ray_pt" ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || die "cannot build ray"
-# shellcheck disable=SC2086
-$CC $CFLAGS -o "$OUT/pfmerr" bench/pfmerr.c -lm || die "cannot build pfmerr"
-# shellcheck disable=SC2086
-$CC $CFLAGS -o "$OUT/svgplot" bench/svgplot.c -lm || die "cannot build svgplot"
-# shellcheck disable=SC2086
-$CC $CFLAGS -o "$OUT/table" bench/table.c -lm || die "cannot build table"
-RAY=$OUT/ray_pt
-
-# cpu CMD...: runs CMD; its CPU seconds (user + system) go to $cpu (in
-# whole milliseconds, as `time` prints them: the shell's own arithmetic).
-cpu() {
-  local TIMEFORMAT='%3U %3S' u s ms
-  { time "$@" >/dev/null 2>"$OUT/pt.err"; } 2>"$OUT/pt.time" || { cat "$OUT/pt.err" >&2; return 1; }
-  read -r u s < <(tail -n 1 "$OUT/pt.time")
-  ms=$((10#${u/./} + 10#${s/./}))
-  cpu=$(printf '%d.%03d' $((ms / 1000)) $((ms % 1000)))
-}
-
 # The arithmetic and the tables are bench/table.c's, as in bench/run.sh;
-# bench/lib.sh names its subcommands.
+# bench/lib.sh names its subcommands, builds the tools and times a run.
+LOG=pt
 . bench/lib.sh
+build_time_tools || die "cannot build ray, pfmerr, svgplot or table"
+RAY=$OUT/ray_pt
 
 # reference NAME SIZE: MIS at $REF_SPP spp, seed 99 (the runs use seed 0:
 # a reference sharing their random numbers would share their noise).
@@ -113,15 +95,7 @@ for item in $SCENES; do
       done
     done
     for est in bsdf nee mis; do
-      img=$OUT/pt-$name-$est-$spp.pfm
-      read -r rmse lit disp <<<"$("$OUT/pfmerr" "$img" "$ref" |
-        sed 's/rmse=\([^ ]*\) lit_rmse=\([^ ]*\) display_rmse=\([^ ]*\).*/\1 \2 \3/')"
-      # shellcheck disable=SC2086
-      read -r lo med hi <<<"$(spread ${times[$est]})"
-      # the rounds' times, in order, last (for the ratios round by round)
-      rounds=$(printf '%s' "${times[$est]% }" | tr ' ' ,)
-      printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$name" "$size" "$est" "$spp" "$med" "$rmse" "$lit" "$disp" \
-        "$lo" "$hi" "$rounds" >>"$OUT/pt.tsv"
+      record "$OUT/pt.tsv" "$name" "$size" "$est" "$spp" "$OUT/pt-$name-$est-$spp.pfm" "$ref" "${times[$est]}"
       # target 1's figures (below): the Cornell box's first BSDF run at 256 spp
       if [ "$name/$est/$spp" = cornell/bsdf/256 ] && [ -z "$e_b" ]; then
         t_b=$med e_b=$rmse rounds_b=$rounds cornell_size=$size
@@ -133,17 +107,8 @@ for item in $SCENES; do
   done
 done
 
-# The slope of log RMSE against log CPU time, least squares, per scene and
-# estimator (runs under 0.05 s left out: their time is mostly start-up).
-slopes=$(table pt-slopes "$OUT/pt.tsv")
-{ echo; echo "slope of log RMSE against log time (unbiased noise: -0.5):"; printf '%s\n' "$slopes" | sed 's/^/  /'; echo; } |
-  tee -a "$OUT/pt.txt"
-
-# The plot: one line per scene and estimator, its slope in its name.
-table pt-plot "$OUT/pt.tsv" |
-  "$OUT/svgplot" --title "make bench: path tracing, time against error (labels: samples per pixel)" \
-    --xlabel "CPU seconds, one thread (median of the rounds)" --ylabel "RMSE (linear) against the $REF_SPP-spp reference" >"$OUT/pt.svg" ||
-  die "svgplot failed"
+fit_and_plot pt "make bench: path tracing, time against error (labels: samples per pixel)" \
+  "RMSE (linear) against the $REF_SPP-spp reference" || die "svgplot failed"
 
 # Target 1: MIS against BSDF sampling at 256 spp on the Cornell box, round
 # by round: each round's BSDF time against the time at which that round's
