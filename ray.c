@@ -2917,6 +2917,50 @@ static void free_scene(Scene *s)
     free(s->lights.emit); free(s->lights.emit_cdf); free(s->lights.emitter);
 }
 
+/* Why the picture will come out black, or NULL: nothing lights the
+ * scene.  The path tracer sees only what emits (a light, kl > 0, the
+ * sky); Whitted's renderer also the ambient, and shows what glows. */
+static const char *why_black(const Scene *s)
+{
+    int i, lit = s->nlight > 0 || luminance(s->ambient) > 0;
+    for (i = 0; i < s->lights.nemit; i++)
+        lit |= s->lights.emit[i].type == SPHERE_LIGHT || s->lights.emit[i].type == TRIANGLE_LIGHT;
+    if (s->set.integrator == PATH && s->lights.nemit == 0)
+        return "nothing in it gives light (no `light`, nothing with kl > 0, a black background):"
+               " the path-traced picture will be black";
+    if (s->set.integrator == WHITTED && !lit && nobj(s) > 0)
+        return "no light reaches its surfaces (no `light`, nothing with kl > 0, ambient 0): only"
+               " what glows and the background will show";
+    return NULL;
+}
+
+/* Whether Whitted's renderer draws random numbers for this scene (a lens,
+ * area lights, a glossy ray): if not, --seed changes nothing. */
+static int whitted_draws(const Scene *s)
+{
+    int i, any = s->cam.lens > 0;
+    for (i = 0; i < s->lights.nemit; i++)
+        any |= s->lights.emit[i].type == TRIANGLE_LIGHT
+               || (s->lights.emit[i].type == SPHERE_LIGHT && !s->lights_centre);
+    for (i = 0; i < s->nmat; i++) any |= s->mat[i].spread;
+    return any;
+}
+
+/* Said once before the render: a picture that will be black, and the
+ * path tracer's options given to Whitted's renderer, which ignores them. */
+static void say_what_is_ignored(const Scene *s, const Args *a)
+{
+    const char *black = why_black(s);
+    if (black) fprintf(stderr, "%s: warning: %s\n", a->scene, black);
+    if (s->set.integrator != WHITTED) return;
+    if (a->estimator >= 0)
+        fprintf(stderr, "ray: warning: --estimator is the path tracer's; Whitted's renderer ignores"
+                " it (add --pt)\n");
+    if (a->seed >= 0 && !whitted_draws(s))
+        fprintf(stderr, "ray: warning: --seed changes nothing here: Whitted's renderer draws random"
+                " numbers only for a lens, area lights and glossy rays\n");
+}
+
 /* The command line's choices for the path tracer (-1: not given) onto the
  * scene, and its lights; 0 with a message when they cannot work. */
 static int settle_path_options(Scene *s, int integrator, int estimator, int roulette, long seed)
@@ -2962,6 +3006,7 @@ int main(int argc, char **argv)
         free_scene(&s); free(a.made);
         return 2;                   /* --no-roulette without -d: a usage error */
     }
+    if (ok) say_what_is_ignored(&s, &a);
     memset(&o, 0, sizeof o);
     o.spp = a.spp ? a.spp : s.set.spp ? s.set.spp : 1;
     o.threads = a.threads;

@@ -227,12 +227,12 @@ void triangulate(const scene_builder *bld, const int *vi, const int *ni, int n, 
  * products (and infinity times a weight of 0 is NaN), and an index of
  * refraction beyond 1e6 either way makes refraction cancel two huge terms
  * and return a direction that is no unit vector: both are refused (the
- * fuzz targets found NaN pixels from each). */
+ * fuzz targets found NaN pixels from each).  So is a colour or weight
+ * below 0: light taken away, negative radiance in a PFM. */
 #define COLOR_LIMIT 1e30
-static int color_ok(const double *c)
-{
-    return fabs(c[0]) <= COLOR_LIMIT && fabs(c[1]) <= COLOR_LIMIT && fabs(c[2]) <= COLOR_LIMIT;
-}
+#define COLOR_RULE "must lie within 1e30 and be 0 or more"
+static int in_range(double x) { return x >= 0 && x <= COLOR_LIMIT; }
+static int color_ok(const double *c) { return in_range(c[0]) && in_range(c[1]) && in_range(c[2]); }
 
 /* The material m into the scene: *mat its index.  A material whose kd + ks
  * + kt exceeds 1 is named in a warning for the path tracer (which scales
@@ -245,12 +245,18 @@ static int add_material(const scene_builder *b, Where w, const scene_material *m
     k[0] = m->kd, k[1] = m->ks, k[2] = m->kt;
     if (!(m->ir >= 1e-6 && m->ir <= 1e6))
         return fail(w, "index of refraction must be between 1e-6 and 1e6", NULL);
-    if (!color_ok(m->color) || !color_ok(k) || !(fabs(m->kl) <= COLOR_LIMIT))
-        return fail(w, "colours and weights must lie within 1e30 either way", NULL);
+    if (!color_ok(m->color) || !color_ok(k) || !in_range(m->kl))
+        return fail(w, "colours and weights " COLOR_RULE, NULL);
     if ((*mat = b->material(b->user, m, msg)) < 0) return fail(w, msg, NULL);
     if (m->kd + m->ks + m->kt > 1) {
         sprintf(msg, "%.100s:%d: warning: kd + ks + kt = %.3g exceeds 1; the path tracer scales"
                 " them to 1", w.file, w.line, m->kd + m->ks + m->kt);
+        b->warning(b->user, 1, msg);
+    }
+    if (m->kd * fmax(m->color[0], fmax(m->color[1], m->color[2])) > 1) {
+        sprintf(msg, "%.100s:%d: warning: kd times the colour = %.3g exceeds 1: the path tracer's"
+                " surface reflects more light than it receives", w.file, w.line,
+                m->kd * fmax(m->color[0], fmax(m->color[1], m->color[2])));
         b->warning(b->user, 1, msg);
     }
     if (m->ks + m->kt > 1) {
@@ -297,7 +303,7 @@ static int add_cone(const scene_builder *b, Where w, const double *x, int mat)
 static int add_light(const scene_builder *b, Where w, const double *pos, const double *color)
 {
     char why[SCENE_WHY];
-    if (!color_ok(color)) return fail(w, "a light's colour must lie within 1e30 either way", NULL);
+    if (!color_ok(color)) return fail(w, "a light's colour " COLOR_RULE, NULL);
     return b->light(b->user, pos, color, why) || fail(w, why, NULL);
 }
 
@@ -575,6 +581,7 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
         }
     if (!strcmp(k, "ambient") || !strcmp(k, "background")) {
         if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
+        if (!color_ok(v)) return fail(w, k[0] == 'a' ? "ambient " COLOR_RULE : "background " COLOR_RULE, NULL);
         set(b, k[0] == 'a' ? SET_AMBIENT : SET_BACKGROUND, v[0], v[1], v[2]);
         return 1;
     }
@@ -756,6 +763,7 @@ static int nff_background(const scene_builder *b, Lexer *lx)
 {
     double x[3];
     if (!nff_numbers(lx, "b", 3, x)) return 0;
+    if (!color_ok(x)) return fail(lx->w, "background " COLOR_RULE, NULL);
     set(b, SET_BACKGROUND, x[0], x[1], x[2]);
     return 1;
 }

@@ -209,3 +209,52 @@ fi
   && ok "--view counts its rays (64 for 8x8)" || bad "--view with --stats counts no rays"
 ./ray -s 8x8 --stats -o "$TMP/c.ppm" scenes/cornell.sph 2>&1 | grep -q '0 point lights, 2 glowing' \
   && ok "--stats: the Cornell box has 0 point lights and 2 glowing triangles" || bad "--stats scene line on the Cornell box"
+
+# A picture that will be wrong says why, at file:line: negative colours,
+# weights, light colours, background and ambient are refused (a light of
+# colour -5 would take light away; a PFM would hold negative radiance).
+neg() {  # $1 file's text, $2 message
+  printf '%s\n' "$1" > "$TMP/neg.sph"
+  ./ray -s 4x4 -o "$TMP/neg.pfm" "$TMP/neg.sph" 2>"$TMP/err"; rc=$?
+  if [ $rc = 1 ] && grep -q "neg.sph:1: $2" "$TMP/err" && [ ! -e "$TMP/neg.pfm" ]; then
+    ok "refused at its line: $1"
+  else
+    bad "not refused as '$2': $1 (exit $rc, $(cat "$TMP/err"))"
+  fi
+}
+neg '0 0 0  1 -1 1  1  1 0 0 0 1' "colours and weights must lie within 1e30 and be 0 or more"
+neg '0 0 0  1 1 1  1  1 0 0 -2 1' "colours and weights must lie within 1e30 and be 0 or more"
+neg 'tri 0 0 0  1 0 0  0 1 0  1 1 1  -.5 0 0 0 1' "colours and weights must lie within 1e30 and be 0 or more"
+neg 'light 0 0 0  1 -5 1' "a light's colour must lie within 1e30 and be 0 or more"
+neg 'background -1 0 0' "background must lie within 1e30 and be 0 or more"
+neg 'background 1e300 1e300 1e300' "background must lie within 1e30 and be 0 or more"
+neg 'ambient 0 0 -.1' "ambient must lie within 1e30 and be 0 or more"
+printf 'v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 8 8\nb -1 0 0\n' > "$TMP/neg.nff"
+./ray -s 4x4 -o "$TMP/neg.pfm" "$TMP/neg.nff" 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "neg.nff:8: background must lie within 1e30 and be 0 or more" "$TMP/err" \
+  && ok "NFF: a negative background is refused at its line" || bad "NFF negative background: exit $rc, $(cat "$TMP/err")"
+
+# Warnings, once each, naming the file: an albedo above 1; a picture that
+# will be black; the path tracer's options given to Whitted's renderer.
+printf '0 0 0  5 1 1  1  1 0 0 0 1\nlight 0 -5 0  1 1 1\n' > "$TMP/w.sph"
+./ray --pt -s 4x4 -o "$TMP/w.ppm" "$TMP/w.sph" 2>"$TMP/err"; rc=$?
+[ $rc = 0 ] && [ "$(grep -c "w.sph:1: warning: kd times the colour = 5 exceeds 1" "$TMP/err")" = 1 ] \
+  && ok "an albedo of 5: one warning at its line, and the render goes on" || bad "albedo 5: exit $rc, $(cat "$TMP/err")"
+printf 'camera 0 -5 0  0 0 0  0 0 1  40\n0 0 0  1 1 1  1  1 0 0 0 1\n' > "$TMP/dark.sph"
+./ray --pt -s 4x4 -o "$TMP/w.ppm" "$TMP/dark.sph" 2>"$TMP/err"
+[ "$(grep -c "dark.sph: warning: nothing in it gives light" "$TMP/err")" = 1 ] \
+  && ok "a path-traced scene with no light and a black background: warned, black" || bad "no light, --pt: $(cat "$TMP/err")"
+./ray -s 4x4 -o "$TMP/w.ppm" "$TMP/dark.sph" 2>"$TMP/err"
+[ "$(grep -c "dark.sph: warning: no light reaches its surfaces" "$TMP/err")" = 1 ] \
+  && ok "a Whitted scene with no light and no ambient: warned" || bad "no light, Whitted: $(cat "$TMP/err")"
+./ray -s 4x4 -o "$TMP/w.ppm" scenes/cornell.sph --whitted 2>"$TMP/err"
+! grep -q "warning: no light" "$TMP/err" && ok "the Cornell box in Whitted's renderer: lit by its lamp, no warning" \
+  || bad "Cornell, Whitted: $(cat "$TMP/err")"
+./ray --estimator nee -s 4x4 -o "$TMP/w.ppm" scenes/whitted.sph 2>"$TMP/err"
+[ "$(grep -c "warning: --estimator is the path tracer's" "$TMP/err")" = 1 ] \
+  && ok "--estimator given to Whitted's renderer: warned" || bad "--estimator, Whitted: $(cat "$TMP/err")"
+./ray --seed 3 -s 4x4 -o "$TMP/w.ppm" scenes/whitted.sph 2>"$TMP/err"
+./ray --seed 3 -s 4x4 -o "$TMP/w.ppm" scenes/soft.sph 2>>"$TMP/err"
+[ "$(grep -c "warning: --seed changes nothing here" "$TMP/err")" = 1 ] \
+  && ok "--seed to Whitted's renderer: warned where it draws no numbers, not where its area light does" \
+  || bad "--seed, Whitted: $(cat "$TMP/err")"
