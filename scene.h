@@ -36,7 +36,9 @@ enum {
     SET_PIXEL_CORNER,   /* v[0]: 1 samples start on a pixel's corner, 0 on its centre */
     SET_ONE_SIDED,      /* v[0]: 1 the triangles still to come are seen from the front only */
     SET_LIGHT_SCALE,    /* v[0]: every light read so far is scaled by it (NFF's rule) */
-    SET_ACCEL           /* word: kd, bvh, grid, none or auto (from accel_name) */
+    SET_ACCEL,          /* word: kd, bvh, grid, none or auto (from accel_name) */
+    SET_SHUTTER,        /* v[0] <= v[1]: the times the shutter opens and closes */
+    SET_MOVE            /* v[0..2]: the velocity of the objects still to come (0: at rest) */
 };
 
 /* What a renderer offers the readers.  Indices count from 0 in the order
