@@ -8,8 +8,8 @@
  *  - at rest: for rays at times spread over the shutter (its two ends
  *    included), the loop over every object (--accel none) hits the same
  *    object as the loop over a copy of the scene with every object moved
- *    to where it stands at that time, at the same t to 1e-9, with the same
- *    point and normal: the ray moved the other way finds what moving the
+ *    to where it stands at that time, at the same t to 2e-12, with the same
+ *    point and normal (to 2e-12 too): the ray moved the other way finds what moving the
  *    object would;
  *  - every structure (kd, bvh, grid): the same object and bitwise the same
  *    t as the loop, for the nearest hit, and the same answer for any hit,
@@ -24,6 +24,7 @@
 
 #define RAYS 20000
 #define TIMES 7                 /* instants of the at-rest check */
+#define TOL (1e4 * REAL_EPS)    /* its t, point and normal: 2e-12 in double */
 
 typedef struct { unsigned long long key, n; } Sequence;
 
@@ -157,13 +158,13 @@ static void check_at_rest(void)
             if (a < 0) continue;
             hits++;
             moving_hits += moves(&moving, a);
-            if (!(fabs(t1 - t2) <= 1e-9 * t2)) { bad++; continue; }
+            if (!(fabs(t1 - t2) <= TOL * t2)) { bad++; continue; }
             {
                 Hit h1, h2;
                 Query q1 = query(r), q2 = query(still);
                 fill_hit(&moving, r, a, t1, &q1, &h1);
                 fill_hit(&placed, still, b, t2, &q2, &h2);
-                if (!(distance(h1.p, h2.p) <= 1e-9 * (1 + maxabs(h2.p)) && distance(h1.n, h2.n) <= 1e-9
+                if (!(distance(h1.p, h2.p) <= TOL * (1 + maxabs(h2.p)) && distance(h1.n, h2.n) <= TOL
                       && h1.time == r.time))
                     bad++;
             }
