@@ -627,10 +627,10 @@ static unsigned long long mix64(unsigned long long z)
  *     DIM_PIXEL_X, _Y       the pixel's shift of its samples  sample_radiance, once a
  *                           (Cranley-Patterson)                 pixel (as its sample -1)
  *     DIM_LENS_U, _V        a point of the lens               reserved: no lens yet
- *     DIM_TIME              the pixel's shift of its instants  pixel_color and
- *                           of the shutter (Cranley-Patterson)  sample_radiance, once a
- *                                                               pixel (as its sample -1),
- *                                                               and only when objects move
+ *     DIM_TIME              the pixel's shift of its          pixel_color and
+ *                           instants of the shutter             sample_radiance, once a
+ *                           (see shutter_time)                  pixel (as its sample -1),
+ *                                                               when something moves
  *   and from DIM_BOUNCE on, a block of BOUNCE_DIMS for each bounce b (0 at the
  *   first hit), slot k of it dimension DIM_BOUNCE + b * BOUNCE_DIMS + k:
  *       LIGHT_CHOICE        which light                       sample_light
