@@ -1858,9 +1858,12 @@ static double probe(const Scene *s, double limit)
     memset(&wk, 0, sizeof wk);
     for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
     for (j = 0; j < PROBE && spent <= limit; j++) {
-        for (i = 0; i < PROBE; i++)
-            trace(s, camera_ray(&s->cam, s->set.w, s->set.h, (i + (real)0.5) * s->set.w / PROBE,
-                                (j + (real)0.5) * s->set.h / PROBE), s->set.depth, 1, &wk);
+        for (i = 0; i < PROBE; i++) {
+            Ray r = camera_ray(&s->cam, s->set.w, s->set.h, (i + (real)0.5) * s->set.w / PROBE,
+                               (j + (real)0.5) * s->set.h / PROBE);
+            r.time = s->shutter[0];     /* within the shutter, which the structure bounds */
+            trace(s, r, s->set.depth, 1, &wk);
+        }
         spent = (double)(clock() - start) / CLOCKS_PER_SEC;
     }
     return spent;
@@ -2667,14 +2670,17 @@ static real farthest(const Scene *s)
  * pictures compare: black 0, blue 25, red 50, yellow 100, white 200 or
  * more.  normal: the shading normal at the hit, x, y, z from -1..1 to 0..1
  * as red, green, blue.  depth: the hit's distance as grey, white at the eye
- * to black at the scene's farthest point.  Nothing hit: black. */
+ * to black at the scene's farthest point.  Nothing hit: black.  Objects
+ * that move are seen where they are as the shutter opens. */
 static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
 {
     Counts before = wk->count;
+    Ray r = camera_ray(&s->cam, s->set.w, s->set.h, i + (real)0.5, j + (real)0.5);
     Hit h;
     int hit;
+    r.time = s->shutter[0];             /* moving objects as the shutter opens */
     wk->count.primary++;
-    hit = nearest_hit(s, camera_ray(&s->cam, s->set.w, s->set.h, i + (real)0.5, j + (real)0.5), &h, wk);
+    hit = nearest_hit(s, r, &h, wk);
     if (s->set.view == VIEW_STEPS)
         return heat((real)(wk->count.steps - before.steps + wk->count.tests - before.tests));
     if (!hit) return v3(0, 0, 0);
