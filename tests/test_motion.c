@@ -228,8 +228,35 @@ static void check_structure(const char *accel, int which)
     free_scene(&s);
 }
 
+/* Through the builder, as scene.c reads `move`: objects under `move 0 0 0`
+ * count as still (so nothing is drawn and the kd-tree clips them exactly,
+ * as before motion blur), those under a velocity as moving. */
+static void check_still(void)
+{
+    Scene s;
+    scene_builder b = builder(&s);
+    scene_material m = { { 1, 1, 1 }, 1, 0, 0, 0, 1, 0 };
+    double zero[3] = { 0, 0, 0 }, v[3] = { 0, 0, 1e-300 }, c[3] = { 0, 0, 0 }, apex[3] = { 0, 0, 2 };
+    int mat, still, moving;
+    char why[SCENE_WHY];
+    default_scene(&s);
+    mat = b.material(b.user, &m, why);
+    b.setting(b.user, SET_MOVE, zero, NULL);
+    b.sphere(b.user, c, 1, mat, why);
+    b.cone(b.user, c, 1, apex, 0, mat, why);
+    still = s.moving;
+    b.setting(b.user, SET_MOVE, v, NULL);
+    b.sphere(b.user, c, 1, mat, why);
+    moving = s.moving;
+    /* objects are numbered spheres first: the still sphere 0, the moving 1, the cone 2 */
+    check(still == 0 && moving == 1 && s.ncone == 1 && !moves(&s, 0) && moves(&s, 1) && !moves(&s, 2),
+          "motion: objects under `move 0 0 0` are still, one under a velocity of 1e-300 moves");
+    free_scene(&s);
+}
+
 int main(void)
 {
+    check_still();
     check_at_rest();
     check_structure("kd", ACCEL_KD);
     check_structure("bvh", ACCEL_BVH);
