@@ -10,10 +10,12 @@
  *
  * HOW TO READ IT.  The lecture comes first, in the order a ray meets it:
  * the types, the vectors, a table of contents (the prototypes), then
- * "for each pixel", the samples (the points of a pixel, random numbers by
- * fixed dimension, and the warps that turn them into points and
- * directions, each with its pdf), the camera, RayTrace(R) (Whitted),
- * L = Le + integral f L cos (Kajiya), finding hits, and the primitives.
+ * "for each pixel", the samples (the points of a pixel, its instants of
+ * the shutter for motion blur, random numbers by fixed dimension, and the
+ * warps that turn them into points and directions, each with its pdf),
+ * the camera, RayTrace(R) (Whitted), L = Le + integral f L cos (Kajiya),
+ * finding hits (with moving objects: each ray meets them where they are
+ * at its time), and the primitives.
  * After the line THE PLUMBING come threads and render()'s hooks, --view,
  * the builder that scene.c fills a Scene through, --stats and main(); a
  * student can stop reading there.
