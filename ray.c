@@ -10,10 +10,12 @@
  *
  * HOW TO READ IT.  The lecture comes first, in the order a ray meets it:
  * the types, the vectors, a table of contents (the prototypes), then
- * "for each pixel", the samples (the points of a pixel, random numbers by
- * fixed dimension, and the warps that turn them into points and
- * directions, each with its pdf), the camera, RayTrace(R) (Whitted),
- * L = Le + integral f L cos (Kajiya), finding hits, and the primitives.
+ * "for each pixel", the samples (the points of a pixel, its instants of
+ * the shutter for motion blur, random numbers by fixed dimension, and the
+ * warps that turn them into points and directions, each with its pdf),
+ * the camera, RayTrace(R) (Whitted), L = Le + integral f L cos (Kajiya),
+ * finding hits (with moving objects: each ray meets them where they are
+ * at its time), and the primitives.
  * After the line THE PLUMBING come threads and render()'s hooks, --view,
  * the builder that scene.c fills a Scene through, --stats and main(); a
  * student can stop reading there.
@@ -171,11 +173,13 @@ typedef struct { real x, y, z; } vec;
  * Whitted's mirror ray spreads into the same lobe. */
 typedef struct { vec color; real kd, ks, kt, kl, ir, shine; int spread; } Material;
 
-typedef struct { vec cen; real rad; int mat; } Sphere;
+/* Every object may move during the shutter (motion blur): at time t it
+ * stands where it was made plus t times its move, a velocity (0: at rest). */
+typedef struct { vec cen; real rad; int mat; vec move; } Sphere;
 
 /* An open cone or cylinder (NFF's `c`): no end caps.  The radius runs from
  * rb at the base to ra at the other end, along the unit axis. */
-typedef struct { vec base, axis; real len, rb, ra; int mat; } Cone;
+typedef struct { vec base, axis; real len, rb, ra; int mat; vec move; } Cone;
 
 /* Vertices and normals are indices into the scene's shared arrays, so two
  * triangles that share an edge share its exact coordinates.  The hit test
@@ -186,6 +190,7 @@ typedef struct {
     vec v0, e1, e2;      /* vert[v[0]], vert[v[1]] - v0, vert[v[2]] - v0 */
     int v[3], n[3];      /* n[0] < 0: no vertex normals, shade flat */
     int mat;
+    vec move;            /* its velocity during the shutter (0: at rest) */
     char cull;           /* 1: one-sided, hit from the front only */
     char degenerate;     /* zero area: never hit */
 } Triangle;
@@ -266,6 +271,9 @@ typedef struct {
     int shadow_rays;          /* Whitted: shadow rays to each area light, a sample */
     int cull;                 /* while reading: `sided 1` for the triangles still to come */
     real glossy;              /* while reading: `glossy S` for the materials still to come */
+    vec move;                 /* while reading: `move` for the objects still to come */
+    real shutter[2];          /* the shutter opens at shutter[0], closes at shutter[1] */
+    int moving;               /* how many objects move (0: no time is ever drawn) */
     char warning[256];        /* said once when the path tracer starts, if set */
     char whitted_warning[256];  /* the same for Whitted's */
     Settings set;
@@ -298,11 +306,13 @@ static void add_light(Scene *s, vec pos, vec color, int sphere);  /* the plumbin
  * surface again, yet it starts in the tree's cells that list it: skip spares
  * that test.  The tree leaves skip out itself (kd_nearest's skip); the loop
  * over every object checks it in hit_object.  tmin is 0 but for a camera
- * with a near clip (hither): hits at t <= tmin do not count. */
-typedef struct { vec o, d; real tmin; int skip; } Ray;
+ * with a near clip (hither): hits at t <= tmin do not count.  time is the
+ * instant of the shutter the ray was sent at: every ray a camera ray leads
+ * to (shadow, reflected, bounced) keeps its camera ray's time. */
+typedef struct { vec o, d; real tmin; int skip; real time; } Ray;
 
 typedef struct {
-    real t;
+    real t, time;       /* where on the ray, and the ray's time */
     int obj, mat;
     vec p;        /* the point */
     vec n, ng;    /* shading and geometric normal, both outward (front) */
@@ -373,6 +383,7 @@ static vec cross(vec a, vec b)
 static vec comb(real a, vec A, vec B) { return add(B, scale(a, A)); }
 /* Multiply by the reciprocal, as minray's vunit does, for identical bits. */
 static vec unit(vec a) { return scale(1 / sqrt(dot(a, a)), a); }
+static int nonzero(vec a) { return a.x != 0 || a.y != 0 || a.z != 0; }
 /* The index of the largest of |x|, |y|, |z|. */
 static int largest_axis(double x, double y, double z)
 {
@@ -417,6 +428,8 @@ static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
 static real random01(const Worker *wk, unsigned dim);
 static real bounce_random(const Worker *wk, int slot);
 static void sample_offset(int k, real anchor, real *dx, real *dy);
+static real time_shift(Worker *wk, const Scene *s, int i, int j);
+static real shutter_time(const Scene *s, int k, real shift);
 static vec from_local(vec n, vec l);
 static vec cosine_hemisphere(real u1, real u2);
 static real cosine_hemisphere_pdf(real cos_theta);
@@ -464,10 +477,10 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
 static void prepare_lights(Scene *s);
 static int choose_light(const Scene *s, real u);
 static real light_choice(const Scene *s, int l);
-static int sample_emitter(const Scene *s, int l, vec x, vec n, real u, real v, vec *wi,
-                          real *dist, vec *Le, real *pdf);
+static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u, real v,
+                          vec *wi, real *dist, vec *Le, real *pdf);
 static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist, Worker *wk);
-static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny);
+static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny, real time);
 static int front_emits(const Scene *s, int i, vec ng, vec wo);
 static void bsdf_at(const Scene *s, const Hit *h, vec wo, Bsdf *b);
 static vec bsdf_eval(const Bsdf *b, vec wo, vec wi);
@@ -484,11 +497,17 @@ static int find_nearest(const Scene *s, Query *q, real *t, Worker *wk);
 static int prim_hit(void *user, int i, void *ray, double tmin, double tmax, double *t);
 static int kind(const Scene *s, int i, int *k);
 static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t);
+static const Ray *at_rest(const Scene *s, int i, const Ray *r, Ray *moved);
+static vec rest_frame(const Scene *s, int i, real time, vec x);
+static int moves(const Scene *s, int i);
+static vec velocity(const Scene *s, int i);
 static void fill_hit(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h);
 static Ray spawn(const Scene *s, const Hit *h, vec dir);
 static int any_hit(const Scene *s, Ray r, real tmax, int *last, Worker *wk);
 static int find_any(const Scene *s, Query *q, real tmax, Worker *wk);
 static void prim_bounds(void *user, int i, double lo[3], double hi[3]);
+static void rest_box(const Scene *s, int i, double lo[3], double hi[3]);
+static void sweep(const Scene *s, int i, double lo[3], double hi[3]);
 static int prim_clip(void *user, int i, const double blo[3], const double bhi[3],
                      double lo[3], double hi[3]);
 
@@ -538,14 +557,18 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
 {
     vec sum = v3(0, 0, 0);
+    real shift = s->moving ? time_shift(wk, s, i, j) : 0;   /* no motion: no numbers drawn */
     int k;
     for (k = 0; k < spp; k++) {
         real dx, dy;
+        Ray r;
         sample_offset(k, s->cam.anchor, &dx, &dy);
         start_sample(wk, s, i, j, k);       /* for a lens, area lights, a glossy lobe */
         wk->count.primary++;
         wk->budget = RAY_BUDGET;
-        sum = add(sum, trace(s, primary_ray(s, i + dx, j + dy, wk), s->set.depth, 1, wk));
+        r = primary_ray(s, i + dx, j + dy, wk);
+        if (s->moving) r.time = shutter_time(s, k, shift);
+        sum = add(sum, trace(s, r, s->set.depth, 1, wk));
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
     return scale((real)1 / spp, sum);
@@ -625,7 +648,10 @@ static unsigned long long mix64(unsigned long long z)
  *     DIM_PIXEL_X, _Y       the pixel's shift of its samples  sample_radiance, once a
  *                           (Cranley-Patterson)                 pixel (as its sample -1)
  *     DIM_LENS_U, _V        a point of the lens               primary_ray (both renderers)
- *     DIM_TIME              an instant of the shutter         reserved: no motion yet
+ *     DIM_TIME              the pixel's shift of its          pixel_color and
+ *                           instants of the shutter             sample_radiance, once a
+ *                           (see shutter_time)                  pixel (as its sample -1),
+ *                                                               when something moves
  *   and from DIM_BOUNCE on, a block of BOUNCE_DIMS for each bounce b (0 at the
  *   first hit), slot k of it dimension DIM_BOUNCE + b * BOUNCE_DIMS + k:
  *       LIGHT_CHOICE        which light                       sample_light
@@ -640,9 +666,8 @@ static unsigned long long mix64(unsigned long long z)
  *
  * Whitted's renderer draws from the same table where it spreads a ray
  * (Cook's distributed ray tracing), its recursion level standing for the
- * bounce.  The time dimension is kept, unused, so that motion blur added
- * later takes its numbers from it and moves no other path's, as the lens
- * moved none when it came. */
+ * bounce.  The lens and time dimensions were kept, unused, before there
+ * was a lens or motion blur; each came and moved no other path's numbers. */
 enum { DIM_PIXEL_X, DIM_PIXEL_Y, DIM_LENS_U, DIM_LENS_V, DIM_TIME, DIM_BOUNCE };
 enum { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE, SPARE,
        BOUNCE_DIMS };
@@ -682,6 +707,37 @@ static void sample_offset(int k, real anchor, real *dx, real *dy)
     *dy = (real)(anchor + (k * a2 - floor(k * a2)));
     if (*dx >= anchor + 0.5) *dx -= 1;          /* wrap into [anchor-1/2, anchor+1/2) */
     if (*dy >= anchor + 0.5) *dy -= 1;
+}
+
+/* Motion blur (Cook, Porter and Carpenter, "Distributed Ray Tracing",
+ * SIGGRAPH 1984): each sample of a pixel sees the scene at its own instant
+ * of the shutter, so that an object moving across the pixel counts there
+ * for the share of the shutter it spends there.  The instants of a pixel's
+ * samples are a 1-D sequence shifted by the pixel's own random number
+ * (DIM_TIME, drawn as its sample -1), as the pixel's points are: */
+static real time_shift(Worker *wk, const Scene *s, int i, int j)
+{
+    start_sample(wk, s, i, j, -1);
+    return random01(wk, DIM_TIME);
+}
+
+/* Sample k's instant: the golden ratio's sequence k g mod 1 (the 1-D
+ * Kronecker sequence with the lowest discrepancy for every count), shifted
+ * by the pixel's shift and wrapped, then stretched over the shutter.  Why
+ * not the strata (k + 1/2)/spp: those pair instant k with R2's point k in a
+ * lattice of 3-D points, whose rows can line up with a motion; g is
+ * rationally independent of R2's two numbers (a quadratic against a cubic
+ * irrational), so (point, instant) together fill the pixel and the shutter
+ * evenly for any spp, known in advance or not.  The shift makes each
+ * instant alone uniform over the shutter, so the mean is unbiased, and
+ * keeps neighbouring pixels from sharing instants (which would show spp
+ * sharp copies of a moving object instead of a smooth streak). */
+static real shutter_time(const Scene *s, int k, real shift)
+{
+    const double g = 0.6180339887498949;        /* (sqrt 5 - 1) / 2 */
+    real u = (real)(k * g - floor(k * g)) + shift;
+    if (u >= 1) u -= 1;
+    return s->shutter[0] + u * (s->shutter[1] - s->shutter[0]);
 }
 
 /* The warps below work in a local frame about the z axis; this turns a
@@ -812,6 +868,7 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
     Ray r;
     r.o = c->eye;
     r.skip = -1;
+    r.time = 0;                 /* the caller sets the sample's instant, if things move */
     r.d = unit(add(add(scale(x - (real)w / 2, c->right),
                        scale((real)h / 2 - y, c->up)), scale(dist, c->fwd)));
     r.tmin = near_clip(c, r.d);
@@ -999,7 +1056,7 @@ static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker 
         if (em->obj == h->obj) continue;        /* a sphere or a flat triangle lights not itself */
         for (q = 0; q < s->shadow_rays; q++) {
             area_point(wk, l, q, &u, &v);
-            sample_emitter(s, l, h->p, n, u, v, &wi, &dist, &Le, &pdf);
+            sample_emitter(s, l, h->p, n, h->time, u, v, &wi, &dist, &Le, &pdf);
             e = dot(n, wi);
             if (!(pdf > 0) || !(e > 0)) continue;   /* facing away: no ray */
             if (!light_visible(s, h, l, wi, dist, wk)) continue;
@@ -1039,7 +1096,9 @@ static vec glossy_mirror(vec mirror, real shine, const Worker *wk)
 static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
                       real *e, vec *to_light, Worker *wk)
 {
-    vec dir = *to_light = unit(sub(l->pos, h->p));
+    /* a glowing sphere that moves is where it is at the hit's instant */
+    vec from = l->sphere >= 0 ? rest_frame(s, l->sphere, h->time, h->p) : h->p;
+    vec dir = *to_light = unit(sub(l->pos, from));
     Ray r;
     Hit blocker;
     real k = l->sphere >= 0 ? s->mat[s->sph[l->sphere].mat].kl : 1;
@@ -1178,10 +1237,12 @@ static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk)
 static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
 {
     Path path;
-    real dx, dy, sx, sy;
+    Ray r;
+    real dx, dy, sx, sy, st;
     start_sample(wk, s, i, j, -1);          /* the pixel's shift: no sample's numbers */
     sx = random01(wk, DIM_PIXEL_X);
     sy = random01(wk, DIM_PIXEL_Y);
+    st = s->moving ? random01(wk, DIM_TIME) : 0;    /* see shutter_time */
     sample_offset(k, (real)0.5, &dx, &dy);
     dx += sx;
     dy += sy;
@@ -1192,7 +1253,9 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     path.beta = v3(1, 1, 1);
     path.rays = 1;
     path.counted = 1;
-    return radiance(s, primary_ray(s, i + dx, j + dy, wk), &path, wk);
+    r = primary_ray(s, i + dx, j + dy, wk);
+    if (s->moving) r.time = shutter_time(s, k, st);
+    return radiance(s, r, &path, wk);
 }
 
 /* L(x, wo) = Le(x, wo) + integral f Li cos, for the ray r arriving at x:
@@ -1256,7 +1319,7 @@ static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path)
     if (!(m->kl > 0) || !front_emits(s, h->obj, h->ng, wo)) return v3(0, 0, 0);
     if (!path->counted && l >= 0 && s->set.estimator == NEE) return v3(0, 0, 0);
     if (!path->counted && l >= 0 && s->set.estimator == MIS)
-        w = power_heuristic(path->pdf, light_pdf(s, l, path->from, path->n_from, h->p, h->ng));
+        w = power_heuristic(path->pdf, light_pdf(s, l, path->from, path->n_from, h->p, h->ng, h->time));
     return scale(w * m->kl, m->color);
 }
 
@@ -1267,7 +1330,7 @@ static vec sky(const Scene *s, vec d, const Path *path)
     real w = 1;
     if (!path->counted && s->set.estimator == NEE) return v3(0, 0, 0);
     if (!path->counted && s->set.estimator == MIS && s->lights.sky >= 0)
-        w = power_heuristic(path->pdf, light_pdf(s, s->lights.sky, path->from, path->n_from, d, d));
+        w = power_heuristic(path->pdf, light_pdf(s, s->lights.sky, path->from, path->n_from, d, d, 0));
     return scale(w, s->background);
 }
 
@@ -1290,8 +1353,8 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
     real dist, pdf, cosi;
     int l = choose_light(s, bounce_random(wk, LIGHT_CHOICE)), delta;
     if (l < 0) return v3(0, 0, 0);
-    delta = sample_emitter(s, l, h->p, b->n, bounce_random(wk, LIGHT_U), bounce_random(wk, LIGHT_V),
-                           &wi, &dist, &Le, &pdf);
+    delta = sample_emitter(s, l, h->p, b->n, h->time, bounce_random(wk, LIGHT_U),
+                           bounce_random(wk, LIGHT_V), &wi, &dist, &Le, &pdf);
     if (!(pdf > 0)) return v3(0, 0, 0);
     pdf *= light_choice(s, l);
     cosi = dot(wi, b->n);
@@ -1403,8 +1466,10 @@ static real light_choice(const Scene *s, int l)
  * u and v, the distance dist to that point (INFINITY for the sky), the
  * radiance Le it sends back along -wi, and the pdf of wi in solid angle.
  * Returns 1 for a point light, which only this can find (its pdf is the
- * choice alone). */
-static int sample_emitter(const Scene *s, int l, vec x, vec n, real u, real v, vec *wi,
+ * choice alone).  A light that moves is sampled where it stands at the
+ * given time: from x as the light at rest sees it (directions and
+ * distances are the same either way). */
+static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u, real v, vec *wi,
                           real *dist, vec *Le, real *pdf)
 {
     const Emitter *e = &s->lights.emit[l];
@@ -1428,6 +1493,7 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, real u, real v, v
         return 0;
     }
     kind(s, e->obj, &k);
+    x = rest_frame(s, e->obj, time, x);
     if (e->type == SPHERE_LIGHT) {
         *pdf = sphere_sample(&s->sph[k], x, u, v, wi, dist);
         m = &s->mat[s->sph[k].mat];
@@ -1444,9 +1510,10 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, real u, real v, v
 }
 
 /* The pdf (in solid angle at x, choice included) with which sample_light
- * would have picked the point y, of normal ny, on light l: what MIS needs
- * for a light found by BSDF sampling.  For the sky, y is the direction. */
-static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny)
+ * would have picked the point y, of normal ny, on light l at the given
+ * time: what MIS needs for a light found by BSDF sampling.  For the sky, y
+ * is the direction (and the time does not matter). */
+static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny, real time)
 {
     const Emitter *e = &s->lights.emit[l];
     vec d;
@@ -1454,6 +1521,8 @@ static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny)
     int k;
     if (e->type == SKY_LIGHT) return light_choice(s, l) * cosine_hemisphere_pdf(dot(y, n));
     kind(s, e->obj, &k);
+    x = rest_frame(s, e->obj, time, x);
+    y = rest_frame(s, e->obj, time, y);
     if (e->type == SPHERE_LIGHT) return light_choice(s, l) * sphere_pdf(&s->sph[k], x, y);
     d = sub(y, x);
     dist = sqrt(dot(d, d));
@@ -1661,12 +1730,14 @@ static int prim_hit(void *user, int i, void *ray, double tmin, double tmax, doub
 {
     const Scene *s = user;
     Query *q = ray;
+    Ray moved;
     real tt, u, v;
     int k;
     (void)tmin;             /* rays start off the surface; see spawn() */
     /* q->r.skip never comes here: the tree leaves it out */
     if (kind(s, i, &k) == TRIANGLE) {   /* hit_object would test it again */
-        if (!hit_triangle(s, &s->tri[k], &q->r, (real)tmax, &tt, &u, &v))
+        const Ray *r = s->moving ? at_rest(s, i, &q->r, &moved) : &q->r;
+        if (!hit_triangle(s, &s->tri[k], r, (real)tmax, &tt, &u, &v))
             return 0;
         q->obj = i, q->t = tt, q->u = u, q->v = v;
     } else if (!hit_object(s, i, &q->r, (real)tmax, &tt))
@@ -1688,9 +1759,11 @@ static int kind(const Scene *s, int i, int *k)
 /* Object i against the ray: 1 and its t when hit with 0 < t <= tmax. */
 static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
 {
+    Ray moved;
     real u, v;
     int k;
     if (i == r->skip) return 0;
+    if (s->moving) r = at_rest(s, i, r, &moved);
     switch (kind(s, i, &k)) {
     case SPHERE: *t = hit_sphere(&s->sph[k], r, r->tmin); break;
     case CONE: *t = hit_cone(&s->cone[k], r, r->tmin); break;
@@ -1699,20 +1772,66 @@ static int hit_object(const Scene *s, int i, const Ray *r, real tmax, real *t)
     return *t <= tmax && *t < INFINITY;         /* INFINITY is a miss */
 }
 
+/* A moving object is hit where it stands at the ray's time.  Rather than
+ * move the object there, the ray moves the other way, by -time x velocity:
+ * the same t (a translation keeps distances along the ray), the object's
+ * own numbers untouched, and no arithmetic at all for an object at rest.
+ * Returns r itself, or the ray moved into *moved. */
+static const Ray *at_rest(const Scene *s, int i, const Ray *r, Ray *moved)
+{
+    if (!moves(s, i)) return r;
+    *moved = *r;
+    moved->o = rest_frame(s, i, r->time, r->o);
+    return moved;
+}
+
+/* The point x as object i at rest sees it at that time: x less the way
+ * the object has come, time x velocity (x itself for an object at rest). */
+static vec rest_frame(const Scene *s, int i, real time, vec x)
+{
+    return moves(s, i) ? comb(-time, velocity(s, i), x) : x;
+}
+
+/* Whether object i moves: never in a scene where nothing does (the test
+ * a static scene pays is s->moving alone). */
+static int moves(const Scene *s, int i)
+{
+    return s->moving && nonzero(velocity(s, i));
+}
+
+/* Object i's velocity, its `move`: the way it goes per unit of time. */
+static vec velocity(const Scene *s, int i)
+{
+    int k;
+    switch (kind(s, i, &k)) {
+    case SPHERE: return s->sph[k].move;
+    case CONE: return s->cone[k].move;
+    }
+    return s->tri[k].move;
+}
+
 /* The point, normals and material of the hit on object i at t.  q (or
  * NULL) may hold the barycentrics of that hit already. */
 static void fill_hit(const Scene *s, Ray r, int i, real t, const Query *q, Hit *h)
 {
     int k, what = kind(s, i, &k);
     real u, v, tt;
+    Ray moved;
+    const Ray *rr = s->moving ? at_rest(s, i, &r, &moved) : &r;
     h->t = t;
+    h->time = r.time;
     h->obj = i;
-    if (what == SPHERE) sphere_surface(&s->sph[k], &r, t, h);
-    else if (what == CONE) cone_surface(&s->cone[k], &r, t, h);
+    if (what == SPHERE) sphere_surface(&s->sph[k], rr, t, h);
+    else if (what == CONE) cone_surface(&s->cone[k], rr, t, h);
     else {
         if (q && q->obj == i && q->t == t) u = q->u, v = q->v;
-        else hit_triangle(s, &s->tri[k], &r, INFINITY, &tt, &u, &v);
+        else hit_triangle(s, &s->tri[k], rr, INFINITY, &tt, &u, &v);
         triangle_surface(s, &s->tri[k], u, v, h);
+    }
+    if (rr != &r) {             /* found at rest: the point back to where the object is */
+        vec way = scale(r.time, velocity(s, i));
+        h->p = add(h->p, way);
+        h->error_scale += maxabs(h->p) + maxabs(way);
     }
 }
 
@@ -1732,6 +1851,7 @@ static Ray spawn(const Scene *s, const Hit *h, vec dir)
     r.o = comb(out ? eps : -eps, h->ng, h->p);
     r.d = dir;
     r.tmin = 0;
+    r.time = h->time;           /* the same instant: a shadow sees the scene as the hit did */
     r.skip = what == TRIANGLE || (what == SPHERE && out) ? h->obj : -1;
     return r;
 }
@@ -1790,9 +1910,19 @@ static int find_any(const Scene *s, Query *q, real tmax, Worker *wk)
     return -1;
 }
 
+/* The box of object i.  A moving object's is swept: every place it takes
+ * while the shutter is open, so that a structure built once finds it at
+ * any ray's time. */
 static void prim_bounds(void *user, int i, double lo[3], double hi[3])
 {
     const Scene *s = user;
+    rest_box(s, i, lo, hi);
+    if (moves(s, i)) sweep(s, i, lo, hi);
+}
+
+/* The box of object i where it was made. */
+static void rest_box(const Scene *s, int i, double lo[3], double hi[3])
+{
     int k;
     switch (kind(s, i, &k)) {
     case SPHERE: sphere_box(&s->sph[k], lo, hi); break;
@@ -1801,18 +1931,31 @@ static void prim_bounds(void *user, int i, double lo[3], double hi[3])
     }
 }
 
-/* A sphere and a triangle are clipped to the box exactly; a cone's box is
- * simply cut to it. */
+/* The box [lo, hi] of object i at rest swept over the shutter: a
+ * translation moves the box along a line, so the union of its boxes at
+ * the shutter's opening and closing holds all those between. */
+static void sweep(const Scene *s, int i, double lo[3], double hi[3])
+{
+    double v[3], lo2[3], hi2[3], t0 = s->shutter[0], t1 = s->shutter[1];
+    int a;
+    to3(velocity(s, i), v);
+    for (a = 0; a < 3; a++) {
+        lo2[a] = lo[a] + t1 * v[a], hi2[a] = hi[a] + t1 * v[a];
+        lo[a] += t0 * v[a], hi[a] += t0 * v[a];
+    }
+    box_union(lo, hi, lo2, hi2);
+}
+
+/* A sphere and a triangle at rest are clipped to the box exactly; a cone's
+ * box, and a moving object's swept box, are simply cut to it. */
 static int prim_clip(void *user, int i, const double blo[3], const double bhi[3],
                      double lo[3], double hi[3])
 {
     const Scene *s = user;
-    int k, a;
-    switch (kind(s, i, &k)) {
-    case SPHERE: return sphere_clip(&s->sph[k], blo, bhi, lo, hi);
-    case TRIANGLE: return triangle_clip(s, &s->tri[k], blo, bhi, lo, hi);
-    }
-    cone_box(&s->cone[k], lo, hi);
+    int k, a, what = kind(s, i, &k);
+    if (what == SPHERE && !moves(s, i)) return sphere_clip(&s->sph[k], blo, bhi, lo, hi);
+    if (what == TRIANGLE && !moves(s, i)) return triangle_clip(s, &s->tri[k], blo, bhi, lo, hi);
+    prim_bounds(user, i, lo, hi);
     for (a = 0; a < 3; a++) {
         if (lo[a] < blo[a]) lo[a] = blo[a];
         if (hi[a] > bhi[a]) hi[a] = bhi[a];
@@ -1859,9 +2002,12 @@ static double probe(const Scene *s, double limit)
     memset(&wk, 0, sizeof wk);
     for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
     for (j = 0; j < PROBE && spent <= limit; j++) {
-        for (i = 0; i < PROBE; i++)
-            trace(s, camera_ray(&s->cam, s->set.w, s->set.h, (i + (real)0.5) * s->set.w / PROBE,
-                                (j + (real)0.5) * s->set.h / PROBE), s->set.depth, 1, &wk);
+        for (i = 0; i < PROBE; i++) {
+            Ray r = camera_ray(&s->cam, s->set.w, s->set.h, (i + (real)0.5) * s->set.w / PROBE,
+                               (j + (real)0.5) * s->set.h / PROBE);
+            r.time = s->shutter[0];     /* within the shutter, which the structure bounds */
+            trace(s, r, s->set.depth, 1, &wk);
+        }
         spent = (double)(clock() - start) / CLOCKS_PER_SEC;
     }
     return spent;
@@ -1948,6 +2094,8 @@ static void add_sphere(Scene *s, vec cen, real rad, int mat)
     p->cen = cen;
     p->rad = rad;
     p->mat = mat;
+    p->move = s->move;
+    s->moving += nonzero(s->move);
     if (s->mat[mat].kl > 0) add_light(s, cen, s->mat[mat].color, s->nsph - 1);
 }
 
@@ -2110,6 +2258,8 @@ static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat)
     c->rb = rb;
     c->ra = ra;
     c->mat = mat;
+    c->move = s->move;
+    s->moving += nonzero(s->move);
 }
 
 /* A cone from base (radius rb) to apex (radius ra). */
@@ -2243,6 +2393,8 @@ static void add_triangle(Scene *s, int a, int b, int c, int na, int nb, int nc, 
     if (na < 0 || nb < 0 || nc < 0) na = nb = nc = -1;
     tr->n[0] = na; tr->n[1] = nb; tr->n[2] = nc;
     tr->mat = mat;
+    tr->move = s->move;
+    s->moving += nonzero(s->move);
     tr->cull = (char)s->cull;
     tr->degenerate = (char)degenerate(s->vert[a], s->vert[b], s->vert[c]);
 }
@@ -2662,14 +2814,17 @@ static real farthest(const Scene *s)
  * pictures compare: black 0, blue 25, red 50, yellow 100, white 200 or
  * more.  normal: the shading normal at the hit, x, y, z from -1..1 to 0..1
  * as red, green, blue.  depth: the hit's distance as grey, white at the eye
- * to black at the scene's farthest point.  Nothing hit: black. */
+ * to black at the scene's farthest point.  Nothing hit: black.  Objects
+ * that move are seen where they are as the shutter opens. */
 static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
 {
     Counts before = wk->count;
+    Ray r = camera_ray(&s->cam, s->set.w, s->set.h, i + (real)0.5, j + (real)0.5);
     Hit h;
     int hit;
+    r.time = s->shutter[0];             /* moving objects as the shutter opens */
     wk->count.primary++;
-    hit = nearest_hit(s, camera_ray(&s->cam, s->set.w, s->set.h, i + (real)0.5, j + (real)0.5), &h, wk);
+    hit = nearest_hit(s, r, &h, wk);
     if (s->set.view == VIEW_STEPS)
         return heat((real)(wk->count.steps - before.steps + wk->count.tests - before.tests));
     if (!hit) return v3(0, 0, 0);
@@ -2810,6 +2965,8 @@ static void build_setting(void *user, int what, const double *v, const char *wor
     case SET_BACKGROUND: s->background = vec_of(v); break;
     case SET_PIXEL_CORNER: s->cam.anchor = v[0] != 0 ? 0 : (real)0.5; break;
     case SET_ONE_SIDED: s->cull = v[0] != 0; break;
+    case SET_SHUTTER: s->shutter[0] = (real)v[0]; s->shutter[1] = (real)v[1]; break;
+    case SET_MOVE: s->move = vec_of(v); break;
     case SET_LIGHT_SCALE:
         for (i = 0; i < s->nlight; i++) s->light[i].color = scale((real)v[0], s->light[i].color);
         break;
@@ -2850,6 +3007,7 @@ static void default_scene(Scene *s)
     s->set.depth = 5;
     s->cam.anchor = (real)0.5;
     s->shadow_rays = 1;
+    s->shutter[1] = 1;                  /* open from time 0 to 1 */
     s->set.integrator = WHITTED;
     s->set.estimator = MIS;
     s->set.roulette = 1;
@@ -2935,10 +3093,10 @@ static const char *why_black(const Scene *s)
 }
 
 /* Whether Whitted's renderer draws random numbers for this scene (a lens,
- * area lights, a glossy ray): if not, --seed changes nothing. */
+ * area lights, a glossy ray, motion): if not, --seed changes nothing. */
 static int whitted_draws(const Scene *s)
 {
-    int i, any = s->cam.lens > 0;
+    int i, any = s->cam.lens > 0 || s->moving > 0;
     for (i = 0; i < s->lights.nemit; i++)
         any |= s->lights.emit[i].type == TRIANGLE_LIGHT
                || (s->lights.emit[i].type == SPHERE_LIGHT && !s->lights_centre);
@@ -2958,7 +3116,7 @@ static void say_what_is_ignored(const Scene *s, const Args *a)
                 " it (add --pt)\n");
     if (a->seed >= 0 && !whitted_draws(s))
         fprintf(stderr, "ray: warning: --seed changes nothing here: Whitted's renderer draws random"
-                " numbers only for a lens, area lights and glossy rays\n");
+                " numbers only for a lens, area lights, glossy rays and motion\n");
 }
 
 /* The command line's choices for the path tracer (-1: not given) onto the

@@ -233,6 +233,10 @@ void triangulate(const scene_builder *bld, const int *vi, const int *ni, int n, 
 #define COLOR_RULE "must lie within 1e30 and be 0 or more"
 static int in_range(double x) { return x >= 0 && x <= COLOR_LIMIT; }
 static int color_ok(const double *c) { return in_range(c[0]) && in_range(c[1]) && in_range(c[2]); }
+static int within_limit(const double *c)    /* either way: a velocity */
+{
+    return fabs(c[0]) <= COLOR_LIMIT && fabs(c[1]) <= COLOR_LIMIT && fabs(c[2]) <= COLOR_LIMIT;
+}
 
 /* The material m into the scene: *mat its index.  A material whose kd + ks
  * + kt exceeds 1 is named in a warning for the path tracer (which scales
@@ -545,7 +549,18 @@ static const struct { const char *key; double lo, hi; int whole; const char *rul
     { "glossy", 0, 1e6, 0, "glossy exponent must be from 0 to 1e6", SET_GLOSSY }
 };
 
-/* A keyword line: ray.c's extensions to minray's format. */
+/* Times of the shutter within 1e6 either way, velocities within 1e30
+ * (within_limit's bound): a displacement time x velocity stays below 1e36,
+ * within even a float's range. */
+#define TIME_LIMIT 1e6
+
+/* A keyword line: ray.c's extensions to minray's format.  Motion blur:
+ * `shutter T0 T1` says when the shutter opens and closes (default 0 1);
+ * `move DX DY DZ` gives every object that follows (sphere lines, tri,
+ * cone, mesh) that velocity, until the next `move` (`move 0 0 0`: at
+ * rest again).  At time t such an object stands where its line puts it
+ * plus t times its velocity; each sample sees one instant of the
+ * shutter. */
 static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
 {
     double v[17];
@@ -596,6 +611,20 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
             set(b, pairs[i].what, !strcmp(tok[1], pairs[i].yes), 0, 0);
             return 1;
         }
+    if (!strcmp(k, "shutter")) {        /* shutter T0 T1: open from time T0 to T1 */
+        if (!numbers(w, k, tok, ntok, 1, 2, v)) return 0;
+        if (!(v[0] <= v[1] && fabs(v[0]) <= TIME_LIMIT && fabs(v[1]) <= TIME_LIMIT))
+            return fail(w, "shutter needs two times, the first no later than the second,"
+                        " each within 1e6 either way", NULL);
+        set(b, SET_SHUTTER, v[0], v[1], 0);
+        return 1;
+    }
+    if (!strcmp(k, "move")) {           /* move DX DY DZ: the velocity of what follows */
+        if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
+        if (!within_limit(v)) return fail(w, "a velocity must lie within 1e30 either way", NULL);
+        set(b, SET_MOVE, v[0], v[1], v[2]);
+        return 1;
+    }
     if (!strcmp(k, "tri")) {
         int c[3], none[3] = { -1, -1, -1 };
         if (!numbers(w, k, tok, ntok, 1, 17, v) || !card_material(b, w, v + 9, &mat)) return 0;

@@ -41,8 +41,10 @@ enum {
     SET_LIGHTS_CENTRE,  /* v[0]: 1 Whitted's glowing spheres light from their centres (minray's
                          * rule), 0 from their whole surface (area lights) */
     SET_SHADOW_RAYS,    /* v[0]: Whitted's shadow rays to each area light, a sample */
-    SET_GLOSSY          /* v[0]: the Phong exponent of the materials still to come (0: none);
+    SET_GLOSSY,         /* v[0]: the Phong exponent of the materials still to come (0: none);
                          * Whitted's mirror ray spreads into its lobe */
+    SET_SHUTTER,        /* v[0] <= v[1]: the times the shutter opens and closes */
+    SET_MOVE            /* v[0..2]: the velocity of the objects still to come (0: at rest) */
 };
 
 /* What a renderer offers the readers.  Indices count from 0 in the order

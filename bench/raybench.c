@@ -370,7 +370,7 @@ static Query rb_query(const RbRay *ray, double o[3], double d[3])
     for (k = 0; k < 3; k++) o[k] = ray->o[k], d[k] = ray->d[k];
     r.o = v3(o[0], o[1], o[2]);
     r.d = v3(d[0], d[1], d[2]);
-    r.skip = -1, r.tmin = 0;
+    r.skip = -1, r.tmin = 0, r.time = 0;
     return query(r);
 }
 
@@ -404,7 +404,7 @@ static double rb_trace(const Scene *s, const RbRay *rays, long n, int bare, int 
         Ray r;
         r.o = v3(rays[i].o[0], rays[i].o[1], rays[i].o[2]);
         r.d = v3(rays[i].d[0], rays[i].d[1], rays[i].d[2]);
-        r.skip = -1, r.tmin = 0;
+        r.skip = -1, r.tmin = 0, r.time = 0;
         if (bare) {
             double o[3], d[3], tmax = INFINITY;
             Query q = rb_query(&rays[i], o, d);
@@ -1152,7 +1152,7 @@ static int rb_far_nearest(const RbFar *F, int which, const RbDRay *r, double *t,
     Query q;
     int i, best = -1, n = nobj(&F->s);
     ry.o = v3(r->o[0], r->o[1], r->o[2]), ry.d = v3(r->d[0], r->d[1], r->d[2]);
-    ry.skip = -1, ry.tmin = 0;
+    ry.skip = -1, ry.tmin = 0, ry.time = 0;
     q = query(ry);
     *t = INFINITY;
     switch (which) {

@@ -320,6 +320,7 @@ static void test_whitted_equals_path(void)
             r.d = unit(sub(target, r.o));
             r.tmin = 0;
             r.skip = -1;
+            r.time = 0;
             ray_mean(&w, r, 0, 7 * j + i, 4000, &m[0], &se[0]);
             ray_mean(&p, r, 1, 7 * j + i, 4000, &m[1], &se[1]);
             if (se[0] == 0 && se[1] == 0) exact &= m[0] == m[1];
@@ -359,6 +360,7 @@ static void test_glossy(void)
     r.d = unit(v3(0, 1, -1));
     r.tmin = 0;
     r.skip = -1;
+    r.time = 0;
     for (k = 0; k < N; k++) {
         double v;
         start_sample(&wk, &s, 0, 0, k);

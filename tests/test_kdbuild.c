@@ -155,7 +155,7 @@ static Ray make_ray(const Frame *f, long k, const vec *spots, int nspots)
     Ray r;
     double a = unif(0, 2 * PI), rad = sqrt(unif(0, 1)), side = k / 6 % 2 ? 1 : -1;
     vec target = at(f, rad * cos(a), rad * sin(a), 0);
-    r.skip = -1, r.tmin = 0;
+    r.skip = -1, r.tmin = 0, r.time = 0;
     r.o = at(f, unif(-2, 2), unif(-2, 2), side * unif(0.1, 2));
     switch (k % 6) {
     case 1: target = at(f, 1e-3 * rad * cos(a), 1e-3 * rad * sin(a), 0); break;  /* the apex */

@@ -221,7 +221,7 @@ static void test_sphere_is_point(void)
             p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
             ry.o = v3(p.x, p.y, 1);             /* below the light, above the floor */
             ry.d = v3(0, 0, -1);
-            ry.tmin = 0, ry.skip = -1;
+            ry.tmin = 0, ry.skip = -1, ry.time = 0;
             path.beta = v3(1, 1, 1), path.rays = 1, path.counted = 1, path.pdf = 0;
             L = radiance(&s, ry, &path, &wk);
             d = sub(c, p);

@@ -54,9 +54,9 @@ static Sphere sphere(double x, double y, double z, double r)
     return s;
 }
 
-static Ray ray(vec o, vec d) { Ray r; r.o = o; r.d = d; r.tmin = 0; r.skip = -1; return r; }
+static Ray ray(vec o, vec d) { Ray r; r.o = o; r.d = d; r.tmin = 0; r.skip = -1; r.time = 0; return r; }
 /* The same, for the intersection tests, which take the ray by pointer. */
-static const Ray *rp(vec o, vec d) { static Ray r; r.o = o; r.d = d; r.tmin = 0; r.skip = -1; return &r; }
+static const Ray *rp(vec o, vec d) { static Ray r; r.o = o; r.d = d; r.tmin = 0; r.skip = -1; r.time = 0; return &r; }
 
 /* The near root in long double, as a reference: 64-bit mantissa, and the
  * stable form, so its error is far below what is tested. */
@@ -397,7 +397,7 @@ static void test_tree_matches_loop(const char *accel, int n)
         Hit a, b;
         int ha, hb;
         Ray ry;
-        ry.skip = -1, ry.tmin = 0;
+        ry.skip = -1, ry.tmin = 0, ry.time = 0;
         ry.o = v3(8 * rnd(&x) - 4, 8 * rnd(&x) - 4, 8 * rnd(&x) - 4);
         ry.d = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5));
         switch (r % 5) {
@@ -480,7 +480,7 @@ static void test_hit_contract(void)
                         for (a = 0; a < 3; a++)
                             o[a] = (a != b ? cen[a] : k / 6 % 2 ? hi[a] : lo[a]) - dists[id] * L * d[a];
                     }
-                    ry.o = v3(o[0], o[1], o[2]), ry.skip = -1, ry.tmin = 0;
+                    ry.o = v3(o[0], o[1], o[2]), ry.skip = -1, ry.tmin = 0, ry.time = 0;
                     qu = query(ry);
                     to3(ry.o, o);
                     rays++;
