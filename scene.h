@@ -36,7 +36,8 @@ enum {
     SET_PIXEL_CORNER,   /* v[0]: 1 samples start on a pixel's corner, 0 on its centre */
     SET_ONE_SIDED,      /* v[0]: 1 the triangles still to come are seen from the front only */
     SET_LIGHT_SCALE,    /* v[0]: every light read so far is scaled by it (NFF's rule) */
-    SET_ACCEL           /* word: kd, bvh, grid, none or auto (from accel_name) */
+    SET_ACCEL,          /* word: kd, bvh, grid, none or auto (from accel_name) */
+    SET_ROUGH           /* v[0]: the GGX roughness alpha of the materials still to come (0: none) */
 };
 
 /* What a renderer offers the readers.  Indices count from 0 in the order
