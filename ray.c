@@ -1557,7 +1557,7 @@ static real ggx_d(real alpha, real cos_h)
 
 /* Smith's Lambda for GGX, for a direction at cos_theta to n: masking is
  * G1 = 1 / (1 + Lambda) (Heitz, "Understanding the Masking-Shadowing
- * Function in Microfacet-Based BRDFs", JCGT 3(2), 2014, eqs. 43 and 72):
+ * Function in Microfacet-Based BRDFs", JCGT 3(2), 2014):
  * Lambda = (sqrt(1 + alpha^2 tan^2 theta) - 1) / 2. */
 static real smith_lambda(real alpha, real cos_theta)
 {
@@ -1572,7 +1572,7 @@ static real smith_g1(real alpha, real cos_theta) { return 1 / (1 + smith_lambda(
  *     f = ggx F(wo.h) D(h) G2(wo, wi) / (4 |n.wo| |n.wi|),  h = unit(wo + wi)
  *
  * with Smith's height-correlated masking-shadowing G2 = 1 / (1 + Lambda(wo)
- * + Lambda(wi)) (Heitz 2014, eq. 99), which is symmetric in wo and wi, as
+ * + Lambda(wi)) (Heitz 2014), which is symmetric in wo and wi, as
  * is all else: the lobe is reciprocal.  F is 1 for the conductor (ks is
  * its reflectance, grey as the mirror's that it replaces), and the exact
  * dielectric Fresnel of COAT_IOR for the coat.  Single scattering only:
@@ -1591,10 +1591,12 @@ static real microfacet_f(const Bsdf *b, vec wo, vec wi)
 /* The share of the light that passes the coat twice, down and up again,
  * for the diffuse base beneath: (1 - F(n.wo)) (1 - F(n.wi)), Fresnel's
  * transmission of a smooth interface at each end.  Symmetric, so the
- * whole stays reciprocal; the coat reflects F(wo.h) at each microfacet and
- * lets through 1 - F(n.wo) at most of what is left, so the two never add
- * up to more than came in (a furnace checks it; the sum is not the exact
- * layered answer, which needs light bounced between coat and base). */
+ * whole stays reciprocal.  Energy: the coat's lobe reflects at most ks,
+ * the base at most kd, and bsdf_at keeps kd + ks <= 1, so no more leaves
+ * than came in (tests/test_pt.c's furnace measures it).  A simple layering,
+ * not the exact one: light bounced between coat and base is lost, and
+ * ks and kd are weights of their own (kd 0.5, ks 0.5 is half a coat over
+ * half a base), as the card's weights are. */
 static real coat_through(const Bsdf *b, vec wo, vec wi)
 {
     return (1 - fresnel(dot(wo, b->n), 1 / (real)COAT_IOR))

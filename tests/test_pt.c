@@ -482,7 +482,7 @@ static void test_energy(void)
 }
 
 /* Heitz's two normalisations of a microfacet surface ("Understanding the
- * Masking-Shadowing Function", JCGT 2014, eqs. 4 and 20), by the midpoint
+ * Masking-Shadowing Function", JCGT 2014), by the midpoint
  * rule over the microfacet normals h: the microfacets' projected area is
  * the surface's, integral of D(h) cos(theta_h) = 1; and seen from wo, the
  * projected area of the microfacets left unmasked is the surface's seen
