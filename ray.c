@@ -1599,8 +1599,8 @@ static real microfacet_f(const Bsdf *b, vec wo, vec wi)
  * half a base), as the card's weights are. */
 static real coat_through(const Bsdf *b, vec wo, vec wi)
 {
-    return (1 - fresnel(dot(wo, b->n), 1 / (real)COAT_IOR))
-           * (1 - fresnel(dot(wi, b->n), 1 / (real)COAT_IOR));
+    return (1 - fresnel(fmax(0, dot(wo, b->n)), 1 / (real)COAT_IOR))   /* wo below a shading */
+           * (1 - fresnel(dot(wi, b->n), 1 / (real)COAT_IOR));          /* normal: F = 1, none */
 }
 
 /* The pdf of the GGX lobe's direction wi: the visible normal h's, times
