@@ -170,8 +170,11 @@ typedef struct { real x, y, z; } vec;
  * the index of refraction inside (the ray bends by 1/ir going in, by ir
  * coming out).  shine > 0 adds a Phong highlight (NFF's materials have one;
  * minray's spheres do not); with spread (the sphere format's `glossy`)
- * Whitted's mirror ray spreads into the same lobe. */
-typedef struct { vec color; real kd, ks, kt, kl, ir, shine; int spread; } Material;
+ * Whitted's mirror ray spreads into the same lobe.  rough > 0 (a scene's
+ * `rough` line) makes the path tracer's ks a rough microfacet surface of
+ * that GGX alpha instead of a mirror: a conductor, or over kd a coat
+ * (bsdf_at); Whitted's ignores it. */
+typedef struct { vec color; real kd, ks, kt, kl, ir, shine, rough; int spread; } Material;
 
 /* Every object may move during the shutter (motion blur): at time t it
  * stands where it was made plus t times its move, a velocity (0: at rest). */
@@ -274,6 +277,7 @@ typedef struct {
     vec move;                 /* while reading: `move` for the objects still to come */
     real shutter[2];          /* the shutter opens at shutter[0], closes at shutter[1] */
     int moving;               /* how many objects move (0: no time is ever drawn) */
+    real rough;               /* while reading: `rough A` for the materials still to come */
     char warning[256];        /* said once when the path tracer starts, if set */
     char whitted_warning[256];  /* the same for Whitted's */
     Settings set;
@@ -431,10 +435,13 @@ static void sample_offset(int k, real anchor, real *dx, real *dy);
 static real time_shift(Worker *wk, const Scene *s, int i, int j);
 static real shutter_time(const Scene *s, int k, real shift);
 static vec from_local(vec n, vec l);
+static vec to_local(vec n, vec w);
 static vec cosine_hemisphere(real u1, real u2);
 static real cosine_hemisphere_pdf(real cos_theta);
 static vec phong_lobe(real shine, real u1, real u2);
 static real phong_lobe_pdf(real shine, real cos_alpha);
+static vec ggx_visible_normal(vec wo, real alpha, real u1, real u2);
+static real ggx_visible_normal_pdf(real alpha, real cos_o, real cos_h, real o_dot_h);
 static vec uniform_disc(real u1, real u2);
 static real uniform_disc_pdf(void);
 static vec sphere_cap(real cap, real u1, real u2);
@@ -488,6 +495,13 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi);
 static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos_pdf, real *pdf);
 static int sample_glass(const Bsdf *b, vec wo, real u, vec *wi, vec *f_cos_pdf);
 static real fresnel(real cosi, real eta);
+static real microfacet_f(const Bsdf *b, vec wo, vec wi);
+static real coat_through(const Bsdf *b, vec wo, vec wi);
+static real microfacet_pdf(const Bsdf *b, vec wo, vec wi);
+static vec microfacet_sample(const Bsdf *b, vec wo, real u1, real u2);
+static real ggx_d(real alpha, real cos_h);
+static real smith_lambda(real alpha, real cos_theta);
+static real smith_g1(real alpha, real cos_theta);
 
 /* finding hits: the only code that knows an acceleration structure exists */
 static int nearest_hit(const Scene *s, Ray r, Hit *h, Worker *wk);
@@ -740,16 +754,31 @@ static real shutter_time(const Scene *s, int k, real shift)
     return s->shutter[0] + u * (s->shutter[1] - s->shutter[0]);
 }
 
-/* The warps below work in a local frame about the z axis; this turns a
- * local vector into the world's: l.x t1 + l.y t2 + l.z n for an
- * orthonormal t1, t2 made from the unit vector n (Duff et al., "Building
- * an Orthonormal Basis, Revisited", JCGT 6(1), 2017). */
-static vec from_local(vec n, vec l)
+/* The warps below work in a local frame about the z axis: t1, t2, n for
+ * an orthonormal t1, t2 made from the unit vector n (Duff et al.,
+ * "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017). */
+static void tangents(vec n, vec *t1, vec *t2)
 {
     real sign = n.z >= 0 ? 1 : -1, a = -1 / (sign + n.z), b = n.x * n.y * a;
-    vec t1 = v3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    vec t2 = v3(b, sign + n.y * n.y * a, -n.y);
+    *t1 = v3(1 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    *t2 = v3(b, sign + n.y * n.y * a, -n.y);
+}
+
+/* A local vector into the world's: l.x t1 + l.y t2 + l.z n. */
+static vec from_local(vec n, vec l)
+{
+    vec t1, t2;
+    tangents(n, &t1, &t2);
     return add(add(scale(l.x, t1), scale(l.y, t2)), scale(l.z, n));
+}
+
+/* And back: the world's w in the frame about n (for a warp that depends on
+ * where it is seen from, ggx_visible_normal). */
+static vec to_local(vec n, vec w)
+{
+    vec t1, t2;
+    tangents(n, &t1, &t2);
+    return v3(dot(w, t1), dot(w, t2), dot(w, n));
 }
 
 /* A direction of the hemisphere about z with pdf cos(theta)/pi, the
@@ -783,6 +812,40 @@ static vec phong_lobe(real shine, real u1, real u2)
 static real phong_lobe_pdf(real shine, real cos_alpha)
 {
     return cos_alpha > 0 ? (shine + 1) / (2 * (real)PI) * pow(cos_alpha, shine) : 0;
+}
+
+/* A microfacet normal h about z with the density of the normals that wo
+ * (wo.z > 0) sees, D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo.z, for the GGX
+ * distribution D of roughness alpha: visible-normal sampling (Heitz,
+ * "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), 2018).
+ * Why it works: stretched by 1/alpha across z, a GGX surface becomes one
+ * of alpha 1, whose microfacets are those of a hemisphere; the normals of
+ * a hemisphere that a direction v sees, weighed by the area they show,
+ * are the points of its silhouette, the disc across v, lifted onto it.  Of
+ * that disc the half towards the pole shows whole, the other half is the
+ * hemisphere's rim seen aslant, a half ellipse squeezed by v.z: so a
+ * uniform point of the disc has its lower half squeezed by v.z (an affine
+ * map along each chord, which keeps it uniform), is lifted along v, and
+ * the normal is stretched back (normals scale by alpha where points scale
+ * by 1/alpha).  Any uniform disc point serves; the concentric map's keeps
+ * neighbouring numbers neighbouring normals. */
+static vec ggx_visible_normal(vec wo, real alpha, real u1, real u2)
+{
+    vec v = unit(v3(alpha * wo.x, alpha * wo.y, wo.z)), t1, t2, d = uniform_disc(u1, u2), m;
+    real across = sqrt(v.x * v.x + v.y * v.y), s = (1 + v.z) / 2, y;
+    t1 = across > 0 ? v3(-v.y / across, v.x / across, 0) : v3(1, 0, 0);
+    t2 = cross(v, t1);
+    y = (1 - s) * sqrt(fmax(0, 1 - d.x * d.x)) + s * d.y;       /* squeezed: [-v.z, 1] of the chord */
+    m = add(add(scale(d.x, t1), scale(y, t2)), scale(sqrt(fmax(0, 1 - d.x * d.x - y * y)), v));
+    return unit(v3(alpha * m.x, alpha * m.y, fmax(0, m.z)));
+}
+
+/* Its pdf, per unit solid angle of h, for cos_o = wo.z, cos_h = h.z and
+ * o_dot_h = wo.h (GGX is isotropic: these three say it all). */
+static real ggx_visible_normal_pdf(real alpha, real cos_o, real cos_h, real o_dot_h)
+{
+    if (!(cos_o > 0 && o_dot_h > 0)) return 0;
+    return smith_g1(alpha, cos_o) * o_dot_h * ggx_d(alpha, cos_h) / cos_o;
 }
 
 /* A uniform point (x, y, 0) of the unit disc, for cosine_hemisphere and
@@ -1196,19 +1259,31 @@ struct Path {
 
 /* A BSDF at one hit: the card's weights as lobes.  kd*colour is a
  * Lambertian albedo; ks is an ideal mirror, or, with a Phong exponent
- * (NFF's materials), a glossy lobe; kt is a smooth dielectric of index ir.
- * The weights are scaled down to sum to 1 where they sum to more (the card's
- * glass ball has 1.1).  n and ng face the side wo comes from; eta is the
- * ratio n1/n2 of the indices for a ray going through. */
+ * (NFF's materials), a glossy lobe, or, with a roughness (`rough`), a GGX
+ * microfacet lobe: a rough conductor alone, a rough coat over kd*colour
+ * with it (microfacet_f, coat_through); kt is a smooth dielectric of
+ * index ir.  The weights are scaled down to sum to 1 where they sum to
+ * more (the card's glass ball has 1.1).  n and ng face the side wo comes
+ * from; eta is the ratio n1/n2 of the indices for a ray going through. */
 struct Bsdf {
     vec n, ng;
-    vec albedo;             /* Lambertian: f = albedo / pi */
+    vec albedo;             /* Lambertian: f = albedo / pi (times coat_through under a coat) */
     real glossy, shine;     /* modified Phong: f = glossy (shine+2)/(2 pi) cos^shine(alpha) */
     real mirror;            /* ideal mirror (a delta lobe) */
+    real ggx, alpha;        /* GGX microfacets of roughness alpha, weight ggx (microfacet_f) */
+    int coat;               /* 1: the GGX lobe is a dielectric coat of index COAT_IOR over albedo */
     real glass, eta;        /* smooth dielectric with Fresnel (delta lobes) */
-    real p[4];              /* the chance to sample each lobe: diffuse, glossy, mirror, glass */
+    real p[5];              /* the chance to sample each lobe: diffuse, glossy, mirror, GGX, glass */
 };
-enum { DIFFUSE_LOBE, GLOSSY_LOBE, MIRROR_LOBE, GLASS_LOBE };
+/* GGX_LOBE stands before GLASS_LOBE: sample_bsdf's walk through the chances
+ * passes a lobe of chance 0 by subtracting 0, so a material without a
+ * roughness picks its lobes from the same numbers exactly as before. */
+enum { DIFFUSE_LOBE, GLOSSY_LOBE, MIRROR_LOBE, GGX_LOBE, GLASS_LOBE, LOBE_KINDS };
+
+/* The coat's index of refraction: a varnish or a plastic's (n = 1.5
+ * reflects 4% head on).  Fixed, since a coated material's ir is the card's
+ * index for kt, which an opaque material leaves at 1 (no coat at all). */
+#define COAT_IOR 1.5
 
 /* The pixel's radiance: the mean of spp paths through random points of
  * it.  A sample that is not finite (from a degenerate scene) is counted
@@ -1553,35 +1628,45 @@ static void bsdf_at(const Scene *s, const Hit *h, vec wo, Bsdf *b)
     }
     b->albedo = scale(k * m->kd, m->color);
     b->shine = m->shine;
-    b->glossy = m->shine > 0 ? k * m->ks : 0;
-    b->mirror = m->shine > 0 ? 0 : k * m->ks;
+    b->alpha = m->rough;
+    b->ggx = m->rough > 0 ? k * m->ks : 0;            /* a roughness makes ks microfacets */
+    b->coat = b->ggx > 0 && m->kd > 0;
+    b->glossy = m->shine > 0 && b->ggx == 0 ? k * m->ks : 0;
+    b->mirror = m->shine > 0 || b->ggx > 0 ? 0 : k * m->ks;
     b->glass = k * m->kt;
     b->p[DIFFUSE_LOBE] = fmax(b->albedo.x, fmax(b->albedo.y, b->albedo.z));
     b->p[GLOSSY_LOBE] = b->glossy;
     b->p[MIRROR_LOBE] = b->mirror;
+    b->p[GGX_LOBE] = b->ggx;
     b->p[GLASS_LOBE] = b->glass;
-    total = b->p[0] + b->p[1] + b->p[2] + b->p[3];
+    total = b->p[0] + b->p[1] + b->p[2] + b->p[3] + b->p[4];
     k = total > 0 ? 1 / total : 0;
-    for (i = 0; i < 4; i++) b->p[i] *= k;
+    for (i = 0; i < LOBE_KINDS; i++) b->p[i] *= k;
 }
 
-/* f(x, wi, wo) for the lobes that are not deltas (Lambert and Phong).  Zero
- * unless wi and wo lie on the same side of the surface, by both normals. */
+/* f(x, wi, wo) for the lobes that are not deltas (Lambert, Phong, GGX).
+ * Zero unless wi and wo lie on the same side of the surface, by both
+ * normals. */
 static vec bsdf_eval(const Bsdf *b, vec wo, vec wi)
 {
     vec f = scale(1 / (real)PI, b->albedo);
+    real g;
     if (!(dot(wi, b->ng) > 0 && dot(wi, b->n) > 0)) return v3(0, 0, 0);
     if (b->glossy > 0) {
         real c = fmax(0, dot(wi, reflect(scale(-1, wo), b->n, dot(wo, b->n))));
-        real g = b->glossy * (b->shine + 2) / (2 * (real)PI) * pow(c, b->shine);
+        g = b->glossy * (b->shine + 2) / (2 * (real)PI) * pow(c, b->shine);
         f = add(f, v3(g, g, g));
+    }
+    if (b->ggx > 0) {
+        g = microfacet_f(b, wo, wi);
+        f = add(b->coat ? scale(coat_through(b, wo, wi), f) : f, v3(g, g, g));
     }
     return f;
 }
 
 /* The pdf with which sample_bsdf draws wi, for the lobes that are not
  * deltas: cosine-weighted for Lambert, cos^shine about the mirror
- * direction for Phong. */
+ * direction for Phong, the visible normals' for GGX. */
 static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
 {
     real cosi = dot(wi, b->n), pdf;
@@ -1590,6 +1675,7 @@ static real bsdf_pdf(const Bsdf *b, vec wo, vec wi)
     if (b->glossy > 0)
         pdf += b->p[GLOSSY_LOBE]
                * phong_lobe_pdf(b->shine, dot(wi, reflect(scale(-1, wo), b->n, dot(wo, b->n))));
+    if (b->ggx > 0) pdf += b->p[GGX_LOBE] * microfacet_pdf(b, wo, wi);
     return pdf;
 }
 
@@ -1613,8 +1699,11 @@ static int sample_bsdf(const Bsdf *b, vec wo, Worker *wk, vec *wi, vec *f_cos_pd
     }
     if (lobe == GLASS_LOBE) return sample_glass(b, wo, u / b->p[lobe], wi, f_cos_pdf);
     if (lobe == DIFFUSE_LOBE) *wi = from_local(b->n, cosine_hemisphere(u1, u2));
-    else *wi = from_local(reflect(scale(-1, wo), b->n, cosi), phong_lobe(b->shine, u1, u2));
-    if (b->glossy == 0) {         /* Lambert alone: f cos / pdf is the albedo over its chance */
+    else if (lobe == GGX_LOBE) {
+        if (!(cosi > 0)) return -1;              /* wo below the shading normal: no microfacet sees it */
+        *wi = microfacet_sample(b, wo, u1, u2);
+    } else *wi = from_local(reflect(scale(-1, wo), b->n, cosi), phong_lobe(b->shine, u1, u2));
+    if (b->glossy == 0 && b->ggx == 0) {   /* Lambert alone: f cos / pdf is the albedo over its chance */
         *pdf = b->p[DIFFUSE_LOBE] * cosine_hemisphere_pdf(dot(*wi, b->n));
         *f_cos_pdf = scale(1 / b->p[DIFFUSE_LOBE], b->albedo);
         return dot(*wi, b->ng) > 0 && *pdf > 0 ? lobe : -1;
@@ -1664,6 +1753,85 @@ static real fresnel(real cosi, real eta)
     rs = (eta * cosi - cost) / (eta * cosi + cost);
     rp = (cosi - eta * cost) / (cosi + eta * cost);
     return (rs * rs + rp * rp) / 2;
+}
+
+/* The GGX (Trowbridge-Reitz) distribution of microfacet normals, of
+ * roughness alpha, at a normal h whose cosine to n is cos_h (Walter et al.,
+ * "Microfacet Models for Refraction through Rough Surfaces", EGSR 2007,
+ * eq. 33, in the form alpha^2 / (pi (cos^2 (alpha^2 - 1) + 1)^2), with the
+ * 1 - cos^2 kept apart so that a smooth surface's peak does not cancel).
+ * Normalised as a density of microfacet area: its projection onto the
+ * surface, the integral of D(h) cos_h over the hemisphere, is 1. */
+static real ggx_d(real alpha, real cos_h)
+{
+    real a2 = alpha * alpha, c2 = cos_h * cos_h, k = (1 - c2) + c2 * a2;
+    return cos_h > 0 ? a2 / ((real)PI * k * k) : 0;
+}
+
+/* Smith's Lambda for GGX, for a direction at cos_theta to n: masking is
+ * G1 = 1 / (1 + Lambda) (Heitz, "Understanding the Masking-Shadowing
+ * Function in Microfacet-Based BRDFs", JCGT 3(2), 2014):
+ * Lambda = (sqrt(1 + alpha^2 tan^2 theta) - 1) / 2. */
+static real smith_lambda(real alpha, real cos_theta)
+{
+    real c2 = cos_theta * cos_theta;
+    return (sqrt(1 + alpha * alpha * (1 - c2) / c2) - 1) / 2;
+}
+
+static real smith_g1(real alpha, real cos_theta) { return 1 / (1 + smith_lambda(alpha, cos_theta)); }
+
+/* The GGX lobe's f for wo and wi above n: Walter et al.'s (eq. 20)
+ *
+ *     f = ggx F(wo.h) D(h) G2(wo, wi) / (4 |n.wo| |n.wi|),  h = unit(wo + wi)
+ *
+ * with Smith's height-correlated masking-shadowing G2 = 1 / (1 + Lambda(wo)
+ * + Lambda(wi)) (Heitz 2014), which is symmetric in wo and wi, as
+ * is all else: the lobe is reciprocal.  F is 1 for the conductor (ks is
+ * its reflectance, grey as the mirror's that it replaces), and the exact
+ * dielectric Fresnel of COAT_IOR for the coat.  Single scattering only:
+ * light that meets a second microfacet is lost, the more the rougher
+ * (tests/test_pt.c measures how much). */
+static real microfacet_f(const Bsdf *b, vec wo, vec wi)
+{
+    real co = dot(wo, b->n), ci = dot(wi, b->n), F = 1;
+    vec h = unit(add(wo, wi));
+    if (!(co > 0 && ci > 0)) return 0;
+    if (b->coat) F = fresnel(dot(wo, h), 1 / (real)COAT_IOR);
+    return b->ggx * F * ggx_d(b->alpha, dot(h, b->n))
+           / (1 + smith_lambda(b->alpha, co) + smith_lambda(b->alpha, ci)) / (4 * co * ci);
+}
+
+/* The share of the light that passes the coat twice, down and up again,
+ * for the diffuse base beneath: (1 - F(n.wo)) (1 - F(n.wi)), Fresnel's
+ * transmission of a smooth interface at each end.  Symmetric, so the
+ * whole stays reciprocal.  Energy: the coat's lobe reflects at most ks,
+ * the base at most kd, and bsdf_at keeps kd + ks <= 1, so no more leaves
+ * than came in (tests/test_pt.c's furnace measures it).  A simple layering,
+ * not the exact one: light bounced between coat and base is lost, and
+ * ks and kd are weights of their own (kd 0.5, ks 0.5 is half a coat over
+ * half a base), as the card's weights are. */
+static real coat_through(const Bsdf *b, vec wo, vec wi)
+{
+    return (1 - fresnel(fmax(0, dot(wo, b->n)), 1 / (real)COAT_IOR))   /* wo below a shading */
+           * (1 - fresnel(dot(wi, b->n), 1 / (real)COAT_IOR));          /* normal: F = 1, none */
+}
+
+/* The pdf of the GGX lobe's direction wi: the visible normal h's, times
+ * the Jacobian of the mirror map from h to wi, dh/dwi = 1 / (4 wo.h)
+ * (Walter et al. 2007, eq. 14). */
+static real microfacet_pdf(const Bsdf *b, vec wo, vec wi)
+{
+    vec h = unit(add(wo, wi));
+    real oh = dot(wo, h);
+    if (!(dot(wi, b->n) > 0)) return 0;
+    return ggx_visible_normal_pdf(b->alpha, dot(wo, b->n), dot(h, b->n), oh) / (4 * oh);
+}
+
+/* A direction from the GGX lobe: wo mirrored about a visible normal. */
+static vec microfacet_sample(const Bsdf *b, vec wo, real u1, real u2)
+{
+    vec h = from_local(b->n, ggx_visible_normal(to_local(b->n, wo), b->alpha, u1, u2));
+    return reflect(scale(-1, wo), h, dot(wo, h));
 }
 
 /* ------------------------------------------------------------ finding hits */
@@ -2912,6 +3080,7 @@ static int build_material(void *user, const scene_material *m, char *why)
         k.shine = ((Scene *)user)->glossy;
         k.spread = 1;
     }
+    k.rough = ((Scene *)user)->rough;        /* the last `rough` line's */
     return add_material(user, k);
 }
 
@@ -2967,6 +3136,7 @@ static void build_setting(void *user, int what, const double *v, const char *wor
     case SET_ONE_SIDED: s->cull = v[0] != 0; break;
     case SET_SHUTTER: s->shutter[0] = (real)v[0]; s->shutter[1] = (real)v[1]; break;
     case SET_MOVE: s->move = vec_of(v); break;
+    case SET_ROUGH: s->rough = (real)v[0]; break;
     case SET_LIGHT_SCALE:
         for (i = 0; i < s->nlight; i++) s->light[i].color = scale((real)v[0], s->light[i].color);
         break;

@@ -594,6 +594,13 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
             set(b, ones[i].what, v[0], 0, 0);
             return 1;
         }
+    if (!strcmp(k, "rough")) {          /* like `sided`: for what follows, until the next */
+        if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
+        if (!(v[0] == 0 || (v[0] >= 1e-3 && v[0] <= 1)))
+            return fail(w, "rough must be 0 (smooth: a mirror) or from 0.001 to 1", tok[1]);
+        set(b, SET_ROUGH, v[0], 0, 0);
+        return 1;
+    }
     if (!strcmp(k, "ambient") || !strcmp(k, "background")) {
         if (!numbers(w, k, tok, ntok, 1, 3, v)) return 0;
         if (!color_ok(v)) return fail(w, k[0] == 'a' ? "ambient " COLOR_RULE : "background " COLOR_RULE, NULL);

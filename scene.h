@@ -44,7 +44,8 @@ enum {
     SET_GLOSSY,         /* v[0]: the Phong exponent of the materials still to come (0: none);
                          * Whitted's mirror ray spreads into its lobe */
     SET_SHUTTER,        /* v[0] <= v[1]: the times the shutter opens and closes */
-    SET_MOVE            /* v[0..2]: the velocity of the objects still to come (0: at rest) */
+    SET_MOVE,           /* v[0..2]: the velocity of the objects still to come (0: at rest) */
+    SET_ROUGH           /* v[0]: the GGX roughness alpha of the materials still to come (0: none) */
 };
 
 /* What a renderer offers the readers.  Indices count from 0 in the order
