@@ -3,7 +3,7 @@
 # part "dist"; also runs alone: bash bench/dist.sh).
 #
 # For each effect's scene (dof: the lens; soft: an area light; glossy:
-# glossy plates) and each renderer (Whitted's, and the path tracer with
+# glossy plates; motion: motion blur) and each renderer (Whitted's, and the path tracer with
 # MIS): a reference by that renderer at BENCH_DIST_REF_SPP samples (seed 99,
 # every core; kept in bench/out while ./ray and the scene are unchanged),
 # then runs at each of BENCH_DIST_SPP samples per pixel on one thread, the
@@ -15,7 +15,7 @@
 # Plotted, log-log, to bench/out/dist.svg.
 #
 # Knobs: BENCH_DIST_REF_SPP (1024), BENCH_DIST_SPP ("1 4 16 64"),
-#        BENCH_DIST_SCENES ("dof:160x80 soft:160x120 glossy:160x80"),
+#        BENCH_DIST_SCENES ("dof:160x80 soft:160x120 glossy:160x80 motion:160x120"),
 #        BENCH_DIST_ROUNDS (BENCH_ROUNDS, else 3).
 set -u -o pipefail
 export LC_ALL=C
@@ -26,7 +26,7 @@ CFLAGS=${CFLAGS:--O2}
 OUT=bench/out
 REF_SPP=${BENCH_DIST_REF_SPP:-1024}
 SPPS=${BENCH_DIST_SPP:-1 4 16 64}
-SCENES=${BENCH_DIST_SCENES:-dof:160x80 soft:160x120 glossy:160x80}
+SCENES=${BENCH_DIST_SCENES:-dof:160x80 soft:160x120 glossy:160x80 motion:160x120}
 ROUNDS=${BENCH_DIST_ROUNDS:-${BENCH_ROUNDS:-3}}
 mkdir -p "$OUT"
 die() { echo "bench/dist.sh: $*" >&2; exit 1; }

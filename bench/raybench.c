@@ -363,16 +363,18 @@ static void rb_tree_line(const Scene *s, double seconds)
 /* ---------------------------------------------------------------- tracing */
 
 /* Ray i as the structures and ray.c's hit callback take it. */
-static Query rb_query(const RbRay *ray, double o[3], double d[3])
+static Query rb_query_at(const RbRay *ray, double o[3], double d[3], real time)
 {
     Ray r;
     int k;
     for (k = 0; k < 3; k++) o[k] = ray->o[k], d[k] = ray->d[k];
     r.o = v3(o[0], o[1], o[2]);
     r.d = v3(d[0], d[1], d[2]);
-    r.skip = -1, r.tmin = 0, r.time = 0;
+    r.skip = -1, r.tmin = 0, r.time = time;
     return query(r);
 }
+
+static Query rb_query(const RbRay *ray, double o[3], double d[3]) { return rb_query_at(ray, o, d, 0); }
 
 /* What rtcIntersect1 returns besides the triangle and t: the barycentrics
  * u and v, kept by the hit callback in q, and the unnormalised e1 x e2. */
@@ -891,9 +893,13 @@ static long rb_count(const char *arg, long max)
  * its height (a twist: neighbours drift apart).  Each frame, four
  * strategies get the structure up to date and trace 256x256 primary rays
  * from the scene's camera: rebuild the kd-tree, rebuild the BVH, refit the
- * BVH built at frame 0, rebuild the grid.  Per strategy: CPU seconds to
- * build (or refit) and to trace, a frame's mean, and the refitted BVH's
- * trace time against the rebuilt one's as the frames go by.  The whole
+ * BVH built at frame 0, rebuild the grid; and for falling balls, whose
+ * motion is a translation, a fifth: one BVH built at frame 0 over the
+ * whole animation as motion blur builds it, each ball bounding its swept
+ * box (its velocity the whole fall, the animation one shutter from 0 to
+ * 1), and each frame's rays traced at that frame's time.  Per strategy:
+ * CPU seconds to build (or refit) and to trace, a frame's mean, and the
+ * refitted BVH's trace time against the rebuilt one's as the frames go by.  The whole
  * animation runs ROUNDS times (3 unless given), each from nothing; each
  * figure is the median of the rounds, printed with the least and the
  * greatest. */
@@ -921,13 +927,13 @@ static void rb_move(Scene *s, const RbMotion *m, double f)
     }
 }
 
-static double rb_trace_cpu(const Scene *s, const RbRay *rays, long n)
+static double rb_trace_cpu(const Scene *s, const RbRay *rays, long n, real time)
 {
     double c0 = rb_cpu();
     long i;
     for (i = 0; i < n; i++) {
         double o[3], d[3], tmax = INFINITY;
-        Query q = rb_query(&rays[i], o, d);
+        Query q = rb_query_at(&rays[i], o, d, time);
         if (s->accel.which == ACCEL_KD) kd_nearest(s->accel.kd, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
         else if (s->accel.which == ACCEL_BVH) bvh_nearest(s->accel.bvh, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
         else grid_nearest(s->accel.grid, &s->accel.prims, o, d, &q, -1, 0, &tmax, NULL);
@@ -935,12 +941,14 @@ static double rb_trace_cpu(const Scene *s, const RbRay *rays, long n)
     return rb_cpu() - c0;
 }
 
-/* One strategy's frame: the structure brought up to date (refit or a new
- * build), its CPU seconds in *build; returns the trace's. */
-static double rb_frame(Scene *s, int strategy, const RbRay *rays, long n, double *build)
+/* One strategy's frame at time f (0 to 1 over the animation): the
+ * structure brought up to date (refit, a new build, or for the swept BVH
+ * nothing after frame 0), its CPU seconds in *build; returns the trace's. */
+static double rb_frame(Scene *s, int strategy, const RbRay *rays, long n, double f, double *build)
 {
     double c0 = rb_cpu();
     if (strategy == 2 && s->accel.bvh) bvh_refit(s->accel.bvh, &s->accel.prims);
+    else if (strategy == 4 && s->accel.bvh) {}
     else {
         if (s->accel.kd) kd_free(s->accel.kd), s->accel.kd = NULL;
         if (s->accel.bvh) bvh_free(s->accel.bvh), s->accel.bvh = NULL;
@@ -948,23 +956,24 @@ static double rb_frame(Scene *s, int strategy, const RbRay *rays, long n, double
         if (!build_accel(s, strategy == 0 ? "kd" : strategy == 3 ? "grid" : "bvh")) exit(1);
     }
     *build = rb_cpu() - c0;
-    return rb_trace_cpu(s, rays, n);
+    return rb_trace_cpu(s, rays, n, strategy == 4 ? (real)f : 0);
 }
 
 #define RB_ANIM_ROUNDS_MAX 9
 static void rb_anim(const char *path, int frames, int movers, int rounds)
 {
-    static const char *const names[4] = { "rebuild kd", "rebuild BVH", "refit BVH", "rebuild grid" };
-    Scene s[4];
+    static const char *const names[5] = { "rebuild kd", "rebuild BVH", "refit BVH", "rebuild grid",
+                                           "swept BVH" };
+    Scene s[5];
     RbMotion m;
     RbRay *rays;
     double eye[3], at[3], up[3], fov, lo[3], hi[3];
-    double bms[4][RB_ANIM_ROUNDS_MAX], tms[4][RB_ANIM_ROUNDS_MAX], all[4][RB_ANIM_ROUNDS_MAX];
+    double bms[5][RB_ANIM_ROUNDS_MAX], tms[5][RB_ANIM_ROUNDS_MAX], all[5][RB_ANIM_ROUNDS_MAX];
     double ratio[3][RB_ANIM_ROUNDS_MAX];
-    RbSpread bs[4], ts[4], as[4], rs[3];
-    int k, f, a, w = 256, round;
+    RbSpread bs[5], ts[5], as[5], rs[3];
+    int k, f, a, w = 256, round, ns = movers > 0 ? 5 : 4;   /* a twist is no translation */
     if (!rb_nff_view(path, eye, at, up, &fov)) rb_die("no view in", path);
-    for (k = 0; k < 4; k++) {
+    for (k = 0; k < ns; k++) {
         default_scene(&s[k]);
         if (!load_scene(&s[k], path)) exit(1);
     }
@@ -981,7 +990,7 @@ static void rb_anim(const char *path, int frames, int movers, int rounds)
     m.height = fabs((hi[0] - lo[0]) * m.up.x) + fabs((hi[1] - lo[1]) * m.up.y) + fabs((hi[2] - lo[2]) * m.up.z);
     m.twist = movers == 0;
     rb_state = 7;
-    for (k = 0; k < 4; k++) {   /* the same balls in each copy */
+    for (k = 0; k < ns; k++) {   /* the same balls in each copy */
         uint64_t seed = rb_state;
         int j;
         if (m.twist) break;
@@ -991,34 +1000,39 @@ static void rb_anim(const char *path, int frames, int movers, int rounds)
             p = add(p, scale((real)(m.height * (1 + rb_uniform())), m.up));   /* above the box */
             add_sphere(&s[k], p, (real)(0.01 * m.height), rb_white(&s[k]));
         }
-        if (k < 3) rb_state = seed;
+        if (k < ns - 1) rb_state = seed;
     }
     m.first = m.twist ? 0 : s[0].nsph - movers;
     m.count = m.twist ? s[0].nsph : movers;
     m.from = malloc(((size_t)m.count + 1) * sizeof *m.from);
     if (!m.from) rb_die("out of memory", NULL);
     for (k = 0; k < m.count; k++) m.from[k] = s[0].sph[m.first + k].cen;
-    for (k = 0; k < 4; k++) build_accel(&s[k], "none");
+    if (ns == 5) {              /* the swept copy: each ball's whole fall as its velocity */
+        for (k = 0; k < m.count; k++) s[4].sph[m.first + k].move = scale((real)(-2 * m.height), m.up);
+        s[4].moving = m.count;
+        s[4].shutter[0] = 0, s[4].shutter[1] = 1;
+    }
+    for (k = 0; k < ns; k++) build_accel(&s[k], "none");
     rays = rb_primary(&s[0], w, w, path);
     printf("animation %s: %d objects, %s, %d frames, %dx%d primary rays a frame, one thread, CPU time;\n"
-           "%d rounds of every frame, the four strategies taking turns at each frame\n",
+           "%d rounds of every frame, the %d strategies taking turns at each frame\n",
            path, nobj(&s[0]), m.twist ? "every sphere twisted about the up axis" : "balls falling through",
-           frames, w, w, rounds);
+           frames, w, w, rounds, ns);
     printf("%6s", "frame");
-    for (k = 0; k < 4; k++) printf("  %-12s build/trace ms", names[k]);
+    for (k = 0; k < ns; k++) printf("  %-12s build/trace ms", names[k]);
     printf("   (the first round)\n");
     for (round = 0; round < rounds; round++) {
-        double build[4] = { 0 }, trace[4] = { 0 };
-        for (k = 0; k < 4; k++) {   /* each round starts from nothing: frame 0 builds */
+        double build[5] = { 0 }, trace[5] = { 0 };
+        for (k = 0; k < ns; k++) {   /* each round starts from nothing: frame 0 builds */
             if (s[k].accel.kd) kd_free(s[k].accel.kd), s[k].accel.kd = NULL;
             if (s[k].accel.bvh) bvh_free(s[k].accel.bvh), s[k].accel.bvh = NULL;
             if (s[k].accel.grid) grid_free(s[k].accel.grid), s[k].accel.grid = NULL;
         }
         for (f = 0; f < frames; f++) {
-            double b[4], t[4];
-            for (k = 0; k < 4; k++) {
-                rb_move(&s[k], &m, (double)f / (frames > 1 ? frames - 1 : 1));
-                t[k] = rb_frame(&s[k], k, rays, (long)w * w, &b[k]);
+            double b[5], t[5], at_f = (double)f / (frames > 1 ? frames - 1 : 1);
+            for (k = 0; k < ns; k++) {
+                if (k < 4) rb_move(&s[k], &m, at_f);    /* the swept copy stays at frame 0 */
+                t[k] = rb_frame(&s[k], k, rays, (long)w * w, at_f, &b[k]);
                 build[k] += b[k], trace[k] += t[k];
             }
             if (f == 0) ratio[0][round] = t[2] / t[1];
@@ -1026,32 +1040,32 @@ static void rb_anim(const char *path, int frames, int movers, int rounds)
             ratio[2][round] = t[2] / t[1];
             if (round == 0 && (f % 10 == 0 || f == frames - 1)) {
                 printf("%6d", f);
-                for (k = 0; k < 4; k++) printf("  %8.2f / %7.2f            ", b[k] * 1e3, t[k] * 1e3);
+                for (k = 0; k < ns; k++) printf("  %8.2f / %7.2f            ", b[k] * 1e3, t[k] * 1e3);
                 printf("\n");
             }
         }
-        for (k = 0; k < 4; k++) {
+        for (k = 0; k < ns; k++) {
             bms[k][round] = build[k] / frames * 1e3, tms[k][round] = trace[k] / frames * 1e3;
             all[k][round] = bms[k][round] + tms[k][round];
         }
     }
-    for (k = 0; k < 4; k++)
+    for (k = 0; k < ns; k++)
         bs[k] = rb_spread(bms[k], rounds), ts[k] = rb_spread(tms[k], rounds), as[k] = rb_spread(all[k], rounds);
     for (k = 0; k < 3; k++) rs[k] = rb_spread(ratio[k], rounds);
     printf("per frame, mean over the frames, ms: the median of the %d rounds (least - greatest)\n", rounds);
-    for (k = 0; k < 4; k++)
+    for (k = 0; k < ns; k++)
         printf("  %-12s build %8.2f (%.2f - %.2f) + trace %7.2f (%.2f - %.2f) = %8.2f (%.2f - %.2f)\n", names[k],
                bs[k].med, bs[k].lo, bs[k].hi, ts[k].med, ts[k].lo, ts[k].hi, as[k].med, as[k].lo, as[k].hi);
     printf("refitted BVH's trace time over a rebuilt one's (median of the rounds): frame 0 %.2f, frame %d %.2f, "
            "frame %d %.2f\n", rs[0].med, frames / 2, rs[1].med, frames - 1, rs[2].med);
-    for (k = 0; k < 4; k++)
+    for (k = 0; k < ns; k++)
         printf("result anim=%s strategy=%d build_ms=%.3f build_lo=%.3f build_hi=%.3f trace_ms=%.3f trace_lo=%.3f "
                "trace_hi=%.3f total_ms=%.3f total_lo=%.3f total_hi=%.3f\n", m.twist ? "twist" : "fall", k,
                bs[k].med, bs[k].lo, bs[k].hi, ts[k].med, ts[k].lo, ts[k].hi, as[k].med, as[k].lo, as[k].hi);
     printf("result anim=%s refit_ratio_first=%.3f refit_ratio_mid=%.3f refit_ratio_last=%.3f\n",
            m.twist ? "twist" : "fall", rs[0].med, rs[1].med, rs[2].med);
     free(rays), free(m.from);
-    for (k = 0; k < 4; k++) rb_free_scene(&s[k]);
+    for (k = 0; k < ns; k++) rb_free_scene(&s[k]);
 }
 
 /* ------------------------------------------------- far from the origin */

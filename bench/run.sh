@@ -66,8 +66,10 @@
 #           gears, and every sphere of SPD balls twisted, 60 frames, one
 #           thread; per frame the build (or refit) and the trace of 256x256
 #           primary rays, for rebuilding the kd-tree, rebuilding the BVH,
-#           refitting the BVH, rebuilding the grid, taking turns at each
-#           frame; the whole animation in BENCH_ROUNDS rounds
+#           refitting the BVH, rebuilding the grid, and (for the falling
+#           balls, a translation) one BVH of swept boxes built at frame 0
+#           and traced at each frame's time, as motion blur does; taking
+#           turns at each frame; the whole animation in BENCH_ROUNDS rounds
 #           (bench/raybench.c anim)
 #   far     kd, bvh and grid far from the origin, one thread: the 100k-triangle
 #           sphere moved to 1e4, 1e6 and 1e8, and the camera to 1e10 and
