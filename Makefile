@@ -1,5 +1,5 @@
 # make          build everything with -O2 (override: make CC=clang CFLAGS=-O3)
-# make test     the test suite; ends with "N passed, N failed"
+# make test     the test suite; ends with "N passed, N failed, N skipped"
 # make stress   longer runs than make test: more rays for every acceleration structure, every SPD scene
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)

@@ -9,12 +9,14 @@
 # skipped.
 for src in kdtree.c bvh.c grid.c; do
   for cc in gcc clang; do
-    command -v $cc >/dev/null || continue
+    command -v $cc >/dev/null || { skip "$src has no warnings under $cc: $cc is not installed"; continue; }
     check "$src has no warnings under $cc -std=c99 -pedantic -Wall -Wextra" \
       $cc -std=c99 -pedantic -Wall -Wextra -Werror -c $src -o "$TMP/a_$cc.o"
   done
   if command -v tcc >/dev/null; then
     check "$src builds with tcc" tcc -c $src -o "$TMP/a_tcc.o"
+  else
+    skip "$src builds with tcc: tcc is not installed"
   fi
 done
 

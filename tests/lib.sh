@@ -1,8 +1,10 @@
 # Shared helpers for tests/*.test.sh (sourced, not run).
-# ok NAME / bad NAME print the line tests/run.sh counts; check NAME CMD... runs
-# CMD and reports PASS when it exits 0.
+# ok NAME / bad NAME / skip NAME: WHY print the lines tests/run.sh counts (a
+# check this machine cannot run is skipped, and says why); check NAME CMD...
+# runs CMD and reports PASS when it exits 0.
 ok()  { echo "PASS $*"; }
 bad() { echo "FAIL $*"; }
+skip() { echo "SKIP $*"; }
 check() { local name=$1; shift; if "$@" >/dev/null 2>&1; then ok "$name"; else bad "$name"; fi; }
 CC=${CC:-cc}
 CFLAGS=${CFLAGS:--O2}

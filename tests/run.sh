@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The test driver behind `make test`.
 # Every tests/*.test.sh is run from the repository root.  A test script
-# prints one line per check, starting with "PASS " or "FAIL ".  A script that
-# exits non-zero without printing a FAIL line counts as one failure, so a
-# crash can never look like success.  The last line is "N passed, N failed".
+# prints one line per check, starting with "PASS ", "FAIL " or "SKIP " (a
+# check this machine cannot run, with why).  A script that exits non-zero
+# without printing a FAIL line counts as one failure, so a crash can never
+# look like success.  The last line is "N passed, N failed, N skipped".
 cd "$(dirname "$0")/.." || exit 2
 # The scripts run side by side, TEST_JOBS at a time (default: one per
 # core), the longest first; their lines are printed in the scripts' own
@@ -22,19 +23,20 @@ for t in $scripts; do
   ( bash "$t" >"$out/$n.out" 2>&1; echo $? >"$out/$n.rc" ) &
 done
 wait
-pass=0 fail=0
+pass=0 fail=0 skipped=0
 for t in tests/*.test.sh; do
   n=$(basename "$t" .test.sh)
   rc=$(cat "$out/$n.rc")
-  grep -E '^(PASS|FAIL) ' "$out/$n.out" | sed "s|^|$n: |"
+  grep -E '^(PASS|FAIL|SKIP) ' "$out/$n.out" | sed "s|^|$n: |"
   p=$(grep -c '^PASS ' "$out/$n.out")
   f=$(grep -c '^FAIL ' "$out/$n.out")
+  k=$(grep -c '^SKIP ' "$out/$n.out")
   if [ "$rc" != 0 ] && [ "$f" = 0 ]; then
     echo "$n: FAIL script exited $rc; its last lines:"
     tail -n 5 "$out/$n.out" | sed 's/^/    /'
     f=1
   fi
-  pass=$((pass + p)) fail=$((fail + f))
+  pass=$((pass + p)) fail=$((fail + f)) skipped=$((skipped + k))
 done
-echo "$pass passed, $fail failed"
+echo "$pass passed, $fail failed, $skipped skipped"
 [ "$fail" = 0 ]

@@ -19,7 +19,7 @@ fi
 ok "spd builds with $CC $CFLAGS"
 # Silent under strict warnings with every compiler here (tcc: it builds).
 for c in gcc clang tcc; do
-  command -v $c >/dev/null || continue
+  command -v $c >/dev/null || { skip "tools/spd.c under $c: $c is not installed"; continue; }
   flags="-std=c99 -pedantic -Wall -Wextra"; [ $c = tcc ] && flags=""
   # shellcheck disable=SC2086 # flags holds several words
   if $c $flags -c tools/spd.c -o "$TMP/spd.o" 2>"$TMP/w.err" && [ ! -s "$TMP/w.err" ]; then
@@ -75,7 +75,7 @@ tree 11 4095 4095 1 0 7
 COUNTS
 
 if [ ! -d "$REF" ]; then
-  echo "spd: comparison with the SPD's own files skipped: $REF absent"
+  skip "spd: the generators against the SPD's own files: $REF is absent (it lies outside the repository)"
   exit 0
 fi
 
