@@ -138,13 +138,7 @@ static void warn_threads(int threads)
  * POSIX (through links, and however the path is spelled), else by name. */
 static int apart(const char *scene, const char *name)
 {
-#ifdef RAY_POSIX
-    struct stat a, b;
-    int same = stat(scene, &a) == 0 && stat(name, &b) == 0 && a.st_dev == b.st_dev
-               && a.st_ino == b.st_ino;
-#else
-    int same = !strcmp(scene, name);
-#endif
+    int same = same_file(scene, name);
     if (same) fprintf(stderr, "ray: -o %s is the scene file; not overwritten\n", name);
     return !same;
 }

@@ -213,16 +213,18 @@ static void write_ppm(FILE *f, const unsigned char *img, int w, int h, int plain
  * fails at once rather than after a long render.  A new or plain file is
  * written to a temporary file of this run's own beside it (FILE.tmp.PID),
  * which is renamed over FILE at the end: a failure or an interrupt never
- * leaves a half-written image, and keeps the old one.  Anything else
- * (stdout, a device such as /dev/null, a pipe, a symbolic link) is written
- * in place and never renamed over or removed. */
+ * leaves a half-written image, and keeps the old one; through a symbolic
+ * link, its target is.  Anything else (stdout, a device such as /dev/null,
+ * a pipe) is written in place and never renamed over or removed. */
 
 /* The temporary file's name, for on_signal, which can be handed nothing:
  * the one global of ray.c (the card has its own).  It is written before the
  * handler is installed, and the handler only reads it. */
 static char signal_tmp[4096];
 
-/* Ctrl-C (SIGINT), SIGTERM, or a closed terminal (SIGHUP) during a render:
+/* Ctrl-C (SIGINT), SIGTERM, a closed terminal (SIGHUP), or any other
+ * signal that ends a program by default and can be caught (SIGQUIT, the
+ * user signals, a timer, a CPU or file-size limit reached) during a render:
  * the temporary file is removed, then the signal raised again with its
  * default action, so that the program ends as that signal ends it (a shell
  * shows 128 + its number) and the old output stays.  Only calls that are
@@ -257,11 +259,17 @@ static int ignored(int sig)
  * for signal_tmp, which no system takes, is left to the default action. */
 static void catch_signals(const char *tmp)
 {
+    static const int sigs[] = { SIGINT, SIGTERM
 #ifdef RAY_POSIX
-    static const int sigs[] = { SIGINT, SIGTERM, SIGHUP };
-#else
-    static const int sigs[] = { SIGINT, SIGTERM };
+        , SIGHUP, SIGQUIT, SIGUSR1, SIGUSR2, SIGALRM, SIGPIPE
 #endif
+#ifdef SIGXCPU                      /* ulimit -t ran out, ulimit -f is reached, and the */
+        , SIGXCPU, SIGXFSZ          /* profiling timers: each ends the program by default */
+#endif
+#ifdef SIGVTALRM
+        , SIGVTALRM, SIGPROF
+#endif
+    };
     size_t i;
     if (tmp && strlen(tmp) >= sizeof signal_tmp) return;
     if (tmp) strcpy(signal_tmp, tmp);
@@ -361,7 +369,7 @@ int open_output(Output *o, const char *name)
 {
     int mode, kind;
     o->name = name;
-    o->tmp = NULL;
+    o->tmp = o->target = NULL;
     o->f = stdout;
     o->format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
     if (!strcmp(name, "-")) {
@@ -370,8 +378,18 @@ int open_output(Output *o, const char *name)
 #endif
         return 1;
     }
+#ifdef RAY_POSIX
+    {   /* through a symbolic link: the link's target is written as any file is,
+         * through a temporary beside it renamed over it at the end (opening
+         * the link would empty the target at once, and an interrupt would
+         * leave it empty); the link stays */
+        struct stat st;
+        if (lstat(name, &st) == 0 && S_ISLNK(st.st_mode) && (o->target = realpath(name, NULL)))
+            o->name = name = o->target;
+    }
+#endif
     kind = output_kind(name, &mode);
-    if (kind == REFUSED) return 0;
+    if (kind == REFUSED) { free(o->target); return 0; }
     o->f = kind == VIA_TEMP ? create_temp(name, &o->tmp) : fopen(name, "wb");
 #ifdef RAY_POSIX
     if (o->f && mode >= 0) fchmod(fileno(o->f), (mode_t)mode);
@@ -382,6 +400,7 @@ int open_output(Output *o, const char *name)
     }
     fprintf(stderr, "%s: cannot write: %s\n", o->tmp ? o->tmp : name, strerror(errno));
     free(o->tmp);
+    free(o->target);
     return 0;
 }
 
@@ -392,6 +411,7 @@ void discard_output(Output *o)
     if (o->tmp) remove(o->tmp);
     if (o->tmp) catch_signals(NULL);
     free(o->tmp);
+    free(o->target);
 }
 
 /* PFM, netpbm's floating-point format: "PF" (colour), the size, and -1 for
@@ -444,5 +464,6 @@ int write_image(Output *o, const Image *img, int plain)
     }
     if (o->tmp) catch_signals(NULL);
     free(o->tmp);
+    free(o->target);
     return ok;
 }

@@ -32,7 +32,7 @@ int output_format(const char *name);
 /* Where the image goes: "-" is stdout; a new or plain file is written as
  * a temporary beside it (tmp), renamed over it at the end; anything else
  * (a device, a pipe, a symbolic link) in place. */
-typedef struct { FILE *f; const char *name; char *tmp; int format; } Output;
+typedef struct { FILE *f; const char *name; char *tmp, *target; int format; } Output;
 
 int open_output(Output *o, const char *name);     /* 0 after a message */
 void discard_output(Output *o);                   /* nothing is left of it */

@@ -3162,7 +3162,7 @@ static scene_builder builder(Scene *s)
     static const scene_builder calls = { NULL, build_material, build_sphere, build_cone,
                                          build_vertex, build_normal, build_vertex_at,
                                          build_triangle, build_light, build_camera,
-                                         build_setting, build_warning };
+                                         build_setting, build_warning, NULL };
     scene_builder b = calls;
     b.user = s;
     return b;
@@ -3186,13 +3186,18 @@ static void default_scene(Scene *s)
 }
 
 
-/* The scene in file, read by scene.c; 0 after a message. */
-static int load_scene(Scene *s, const char *file)
+/* The scene in file, read by scene.c, for a render that writes output
+ * (which no mesh the scene names may be; NULL: no output); 0 after a
+ * message. */
+static int load_scene_for(Scene *s, const char *file, const char *output)
 {
     scene_builder b = builder(s);
+    b.output = output;
     default_scene(s);
     return read_scene(&b, file);
 }
+
+#define load_scene(s, file) load_scene_for(s, file, NULL)    /* for the tests: no output */
 
 
 
@@ -3324,7 +3329,7 @@ int main(int argc, char **argv)
 
     if (done >= 0) return done;
     load = now();
-    ok = load_scene(&s, a.scene);
+    ok = load_scene_for(&s, a.scene, strcmp(a.output, "-") ? a.output : NULL);
     if (ok && a.w) { s.set.w = a.w; s.set.h = a.h; }
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", a.scene);

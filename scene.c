@@ -54,6 +54,8 @@ static int number(Where w, const char *tok, double *out)
 {
     char *end;
     double v = strtod(tok, &end);
+    if (end != tok && *end == ',')
+        return fail(w, "numbers are parted by blanks, not commas", tok);
     if (end == tok || *end) return fail(w, "not a number", tok);
     if (!isfinite(v)) return fail(w, "number must be finite", tok);
     *out = (double)(REAL)v;       /* as the renderer keeps it */
@@ -427,11 +429,16 @@ int read_obj(const scene_builder *b, const char *file, int mat, const char *scen
     Where w, from;
     int plain = plain_file(file);
     FILE *f = plain ? fopen(file, "r") : NULL;
+    char why[SCENE_WHY + 64];
     if (!line || !tok || !vi || !ni) out_of_memory();
     from.file = scene;
     from.line = at;
-    if (!plain) ok = fail(from, "mesh is not a plain file (a directory, device or pipe)", file);
-    else if (!f) ok = fail(from, "cannot open mesh", strerror(errno));
+    sprintf(why, "%.*s (%.60s)", SCENE_WHY, file, plain && !f ? strerror(errno) : "");
+    if (b->output && same_file(file, b->output)) {
+        ok = fail(from, "the mesh is the output file (-o); not overwritten", file);
+        if (f) fclose(f), f = NULL;
+    } else if (!plain) ok = fail(from, "mesh is not a plain file (a directory, device or pipe)", file);
+    else if (!f) ok = fail(from, "cannot open mesh", why);     /* which path, and why not */
     w.file = file;
     w.line = 0;
     while (ok && next_line(f, line, OBJ_LINE, &w, &ok)) {
@@ -889,6 +896,16 @@ static int load_nff(const scene_builder *b, FILE *f, Where w)
 }
 
 /* Does name end with ext (given in lower case), in any case? */
+int same_file(const char *a, const char *b)
+{
+#ifdef RAY_POSIX
+    struct stat x, y;
+    return stat(a, &x) == 0 && stat(b, &y) == 0 && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
+#else
+    return !strcmp(a, b);
+#endif
+}
+
 int has_extension(const char *name, const char *ext)
 {
     size_t n = strlen(name), k = strlen(ext), i;

@@ -68,6 +68,8 @@ typedef struct {
     void (*setting)(void *user, int what, const double *v, const char *word);
     /* said once when the path tracer (path 1) or Whitted's (0) starts */
     void (*warning)(void *user, int path, const char *text);
+    const char *output;                     /* the image to be written (-o), which no mesh
+                                             * may be; NULL: none */
 } scene_builder;
 
 /* The scene in file: NFF when its name ends .nff (any case), else the
@@ -96,5 +98,6 @@ const char *accel_name(const char *name);
 const char *file_part(const char *path);             /* the name after the directories */
 char *beside(const char *scene, const char *name);   /* name relative to scene's directory */
 int has_extension(const char *name, const char *ext);/* ext in lower case, in any case */
+int same_file(const char *a, const char *b);         /* through links, however spelled (POSIX) */
 
 #endif

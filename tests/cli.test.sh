@@ -258,3 +258,13 @@ printf 'camera 0 -5 0  0 0 0  0 0 1  40\n0 0 0  1 1 1  1  1 0 0 0 1\n' > "$TMP/d
 [ "$(grep -c "warning: --seed changes nothing here" "$TMP/err")" = 1 ] \
   && ok "--seed to Whitted's renderer: warned where it draws no numbers, not where its area light does" \
   || bad "--seed, Whitted: $(cat "$TMP/err")"
+# Messages that point the right way: commas between numbers; which path a
+# mesh line tried.
+printf '0, 0, 0  1 1 1  1  1 0 0 0 1\n' > "$TMP/comma.sph"
+./ray -s 4x4 -o "$TMP/c.ppm" "$TMP/comma.sph" 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "comma.sph:1: numbers are parted by blanks, not commas: 0," "$TMP/err" \
+  && ok "commas between numbers: said so at the line" || bad "commas: exit $rc, $(cat "$TMP/err")"
+printf 'mesh nowhere.obj  .9 .5 .2   .7 .3 0 0 1\n' > "$TMP/nomesh.sph"
+./ray -s 4x4 -o "$TMP/c.ppm" "$TMP/nomesh.sph" 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "nomesh.sph:1: cannot open mesh: $TMP/nowhere.obj (No such file or directory)" "$TMP/err" \
+  && ok "a mesh that cannot be opened: the path tried, and why" || bad "missing mesh: exit $rc, $(cat "$TMP/err")"

@@ -69,7 +69,9 @@ wait_for_temp() {  # wait_for_temp PATTERN COUNT: up to 10 s for COUNT files
 }
 mkdir "$TMP/out"
 set -m   # job control: a background job would otherwise ignore SIGINT
-for sig in INT TERM; do
+ulimit -c 0 2>/dev/null   # SIGQUIT, SIGXCPU and SIGXFSZ dump core by default: no core files here
+# every signal that ends a program by default and can be caught
+for sig in INT TERM HUP QUIT USR1 USR2 ALRM PIPE XCPU XFSZ VTALRM PROF; do
   echo "old image" > "$TMP/out/x.ppm"
   ./ray $big -o "$TMP/out/x.ppm" 2>/dev/null & pid=$!
   wait_for_temp "$TMP/out/x.ppm.tmp.*" 1; kill -$sig $pid; wait $pid; rc=$?
@@ -79,6 +81,32 @@ for sig in INT TERM; do
     || bad "SIG$sig: exit $rc (want $want), left: $(ls "$TMP/out" | tr '\n' ' ')"
 done
 set +m
+
+# -o through a symbolic link: the link's target gets the image, through a
+# temporary beside it renamed over it at the end (so an interrupt leaves the
+# old image whole, not an emptied file); the link stays a link.
+echo "old image" > "$TMP/out/target.ppm"; ln -s target.ppm "$TMP/out/link.ppm"
+set -m
+./ray $big -o "$TMP/out/link.ppm" 2>/dev/null & pid=$!
+wait_for_temp "$TMP/out/target.ppm.tmp.*" 1; kill -INT $pid; wait $pid
+set +m
+[ "$(cat "$TMP/out/target.ppm")" = "old image" ] && [ -L "$TMP/out/link.ppm" ] && ! ls "$TMP/out" | grep -q tmp \
+  && ok "-o through a symbolic link, interrupted: the target keeps its old image whole, no temporary left" \
+  || bad "-o through a link, interrupted: target '$(head -c 20 "$TMP/out/target.ppm")', left: $(ls "$TMP/out" | tr '\n' ' ')"
+./ray -s 8x8 -o "$TMP/out/link.ppm" scenes/minray.sph 2>/dev/null
+[ -L "$TMP/out/link.ppm" ] && [ "$(head -c 2 "$TMP/out/target.ppm")" = P6 ] && ! ls "$TMP/out" | grep -q tmp \
+  && ok "-o through a symbolic link: the target gets the image, the link stays a link" \
+  || bad "-o through a link: $(ls -l "$TMP/out" | tr '\n' ' ')"
+rm -f "$TMP/out/link.ppm" "$TMP/out/target.ppm"
+
+# -o naming a mesh the scene reads is refused, and the mesh is kept.
+cp scenes/ball.obj "$TMP/out/ball.obj"; cp scenes/ball.obj "$TMP/ball.keep"
+printf 'mesh ball.obj  .9 .5 .2   .7 .3 0 0 1\n' > "$TMP/out/m.sph"
+./ray -s 8x8 -o "$TMP/out/ball.obj" "$TMP/out/m.sph" 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q "m.sph:1: the mesh is the output file (-o); not overwritten" "$TMP/err" \
+  && cmp -s "$TMP/out/ball.obj" "$TMP/ball.keep" && ok "-o naming the scene's mesh: refused at the mesh line, the mesh kept" \
+  || bad "-o naming a mesh: exit $rc, $(cat "$TMP/err")"
+rm -f "$TMP/out/ball.obj" "$TMP/out/m.sph"
 
 # Two runs at once with the same -o: each has a temporary file of its own.
 ./ray $big -o "$TMP/out/x.ppm" 2>/dev/null & p1=$!
