@@ -274,6 +274,7 @@ typedef struct {
     int shadow_rays;          /* Whitted: shadow rays to each area light, a sample */
     int cull;                 /* while reading: `sided 1` for the triangles still to come */
     real glossy;              /* while reading: `glossy S` for the materials still to come */
+    int frame;                /* an OBJ file alone: frame_mesh() sets the camera and a light */
     vec move;                 /* while reading: `move` for the objects still to come */
     real shutter[2];          /* the shutter opens at shutter[0], closes at shutter[1] */
     int moving;               /* how many objects move (0: no time is ever drawn) */
@@ -3137,6 +3138,7 @@ static void build_setting(void *user, int what, const double *v, const char *wor
     case SET_SHUTTER: s->shutter[0] = (real)v[0]; s->shutter[1] = (real)v[1]; break;
     case SET_MOVE: s->move = vec_of(v); break;
     case SET_ROUGH: s->rough = (real)v[0]; break;
+    case SET_FRAME: s->frame = 1; break;
     case SET_LIGHT_SCALE:
         for (i = 0; i < s->nlight; i++) s->light[i].color = scale((real)v[0], s->light[i].color);
         break;
@@ -3189,12 +3191,44 @@ static void default_scene(Scene *s)
 /* The scene in file, read by scene.c, for a render that writes output
  * (which no mesh the scene names may be; NULL: no output); 0 after a
  * message. */
+/* A mesh alone (an OBJ file as the scene) framed: the camera 2 box sizes
+ * in front of its box's centre, a little right and above, looking at it,
+ * y up as OBJ files have it; one white light beside the camera; a little
+ * ambient light.  0 when there is nothing to frame. */
+static int frame_mesh(Scene *s)
+{
+    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+    double c[3], size = 0;
+    real v[10];
+    int i, a;
+    for (i = 0; i < s->nvert; i++) {
+        double p[3];
+        to3(s->vert[i], p);
+        for (a = 0; a < 3; a++) lo[a] = fmin(lo[a], p[a]), hi[a] = fmax(hi[a], p[a]);
+    }
+    for (a = 0; a < 3; a++) {
+        c[a] = lo[a] / 2 + hi[a] / 2;
+        size = fmax(size, hi[a] - lo[a]);
+    }
+    if (!(size > 0 && size < 1e150)) return 0;
+    v[0] = (real)(c[0] + 0.6 * size), v[1] = (real)(c[1] + 0.5 * size), v[2] = (real)(c[2] + 2 * size);
+    v[3] = (real)c[0], v[4] = (real)c[1], v[5] = (real)c[2];
+    v[6] = 0, v[7] = 1, v[8] = 0, v[9] = 40;
+    if (!set_camera(s, v, (char[SCENE_WHY]){ 0 })) return 0;
+    add_light(s, v3(v[0] - (real)size, v[1] + (real)size, v[2]), v3(1, 1, 1), -1);
+    s->ambient = v3((real)0.1, (real)0.1, (real)0.1);
+    return 1;
+}
+
 static int load_scene_for(Scene *s, const char *file, const char *output)
 {
     scene_builder b = builder(s);
     b.output = output;
     default_scene(s);
-    return read_scene(&b, file);
+    if (!read_scene(&b, file)) return 0;
+    if (s->frame && !frame_mesh(s))
+        fprintf(stderr, "%s: warning: the mesh has no extent to frame; the default camera sees it\n", file);
+    return 1;
 }
 
 #define load_scene(s, file) load_scene_for(s, file, NULL)    /* for the tests: no output */
@@ -3333,6 +3367,9 @@ int main(int argc, char **argv)
     if (ok && a.w) { s.set.w = a.w; s.set.h = a.h; }
     load = now() - load;
     if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", a.scene);
+    if (ok && s.frame)
+        fprintf(stderr, "%s: an OBJ mesh alone: grey, seen by a camera framing its box (y up),"
+                " lit by one light\n", a.scene);
     if (a.depth) s.set.depth = s.set.max_rays = a.depth;
     accel = a.accel ? a.accel : s.set.accel_line ? s.set.accel_line : "auto";
     if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {

@@ -917,6 +917,23 @@ int has_extension(const char *name, const char *ext)
 
 /* The scene by its name: NFF when it ends .nff (or .NFF), else the sphere
  * format. */
+/* An OBJ file as the whole scene: its mesh in a grey Lambertian material,
+ * and the renderer asked to frame it (SET_FRAME: a camera on its box, a
+ * light), so that any mesh renders with one command. */
+static int load_obj_alone(const scene_builder *b, const char *file)
+{
+    scene_material m;
+    Where w;
+    int mat;
+    w.file = file;
+    w.line = 0;
+    m.color[0] = m.color[1] = m.color[2] = 0.8;
+    m.kd = 0.8, m.ks = m.kt = m.kl = m.shine = 0, m.ir = 1;
+    if (!add_material(b, w, &m, &mat) || !read_obj(b, file, mat, file, 0)) return 0;
+    set(b, SET_FRAME, 1, 0, 0);
+    return 1;
+}
+
 int read_scene(const scene_builder *b, const char *file)
 {
     Where w;
@@ -925,6 +942,10 @@ int read_scene(const scene_builder *b, const char *file)
     w.file = file;
     w.line = 0;
     if (!f) return fail(w, "cannot open scene", strerror(errno));
+    if (has_extension(file, ".obj")) {
+        fclose(f);
+        return load_obj_alone(b, file);
+    }
     ok = has_extension(file, ".nff") ? load_nff(b, f, w) : load_sph(b, f, w);
     if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
     fclose(f);

@@ -45,7 +45,8 @@ enum {
                          * Whitted's mirror ray spreads into its lobe */
     SET_SHUTTER,        /* v[0] <= v[1]: the times the shutter opens and closes */
     SET_MOVE,           /* v[0..2]: the velocity of the objects still to come (0: at rest) */
-    SET_ROUGH           /* v[0]: the GGX roughness alpha of the materials still to come (0: none) */
+    SET_ROUGH,          /* v[0]: the GGX roughness alpha of the materials still to come (0: none) */
+    SET_FRAME           /* an OBJ file alone: the renderer frames it (a camera, a light) */
 };
 
 /* What a renderer offers the readers.  Indices count from 0 in the order
@@ -72,8 +73,9 @@ typedef struct {
                                              * may be; NULL: none */
 } scene_builder;
 
-/* The scene in file: NFF when its name ends .nff (any case), else the
- * sphere format.  0 after a message on stderr. */
+/* The scene in file: NFF when its name ends .nff (any case), a Wavefront
+ * OBJ mesh alone when .obj (then SET_FRAME), else the sphere format.  0
+ * after a message on stderr. */
 int read_scene(const scene_builder *b, const char *file);
 
 /* A Wavefront OBJ mesh (v, vn and f) in material mat; `scene` and `line`

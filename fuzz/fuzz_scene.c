@@ -28,6 +28,7 @@
 #include "../ray.c"
 #undef main
 
+#include <ctype.h>
 #include <unistd.h>
 
 #define SPH 1
@@ -124,33 +125,6 @@ static int beyond_float_range(Scene *s)
  * here, and their reproducers kept as tests (fuzz/crashes-found/README.md,
  * tests/fuzzfound.test.sh). */
 
-#if FORMAT == OBJ
-/* A camera that sees the whole mesh from outside its box, and a light
- * beside the eye; 0 when the box gives no such view (empty, not finite). */
-static int frame_mesh(Scene *s)
-{
-    double lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-    double c[3], size = 0;
-    real v[10];
-    int i, a;
-    for (i = 0; i < s->nvert; i++) {
-        double p[3];
-        to3(s->vert[i], p);
-        for (a = 0; a < 3; a++) lo[a] = fmin(lo[a], p[a]), hi[a] = fmax(hi[a], p[a]);
-    }
-    for (a = 0; a < 3; a++) {
-        c[a] = lo[a] / 2 + hi[a] / 2;
-        size = fmax(size, hi[a] - lo[a]);
-    }
-    if (!(size > 0 && size < 1e300)) return 0;
-    v[0] = c[0] + 0.6 * size, v[1] = c[1] - 2 * size, v[2] = c[2] + 0.9 * size;
-    v[3] = c[0], v[4] = c[1], v[5] = c[2];
-    v[6] = 0, v[7] = 0, v[8] = 1, v[9] = 50;
-    if (!set_camera(s, v, (char[SCENE_WHY]){ 0 })) return 0;
-    add_light(s, v3(v[0] - 0.5 * size, v[1], v[2] + size), v3(1, 1, 1), -1);
-    return 1;
-}
-#endif
 
 #if FORMAT == SPH
 /* A mesh line may name only a file beside the scene, in the temporary

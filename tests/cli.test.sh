@@ -268,3 +268,13 @@ printf 'mesh nowhere.obj  .9 .5 .2   .7 .3 0 0 1\n' > "$TMP/nomesh.sph"
 ./ray -s 4x4 -o "$TMP/c.ppm" "$TMP/nomesh.sph" 2>"$TMP/err"; rc=$?
 [ $rc = 1 ] && grep -q "nomesh.sph:1: cannot open mesh: $TMP/nowhere.obj (No such file or directory)" "$TMP/err" \
   && ok "a mesh that cannot be opened: the path tried, and why" || bad "missing mesh: exit $rc, $(cat "$TMP/err")"
+# An OBJ file as the scene: framed by a camera on its box, lit, said once.
+./ray -s 24x24 -o "$TMP/obj.pfm" scenes/ball.obj 2>"$TMP/err"; rc=$?
+if [ $rc = 0 ] && [ "$(grep -c "ball.obj: an OBJ mesh alone" "$TMP/err")" = 1 ] && python3 -c "
+import struct, sys
+d = open('$TMP/obj.pfm', 'rb').read(); h = d.split(b'\n', 3); w, hh = map(int, h[1].split())
+v = struct.unpack('<%df' % (3 * w * hh), h[3][:12 * w * hh])
+lit = sum(1 for x in v[0::3] if x > 0.2)
+sys.exit(0 if lit > w * hh // 4 and v[0] < 0.05 else 1)   # the mesh fills the middle, lit; a corner is dark
+"; then ok "./ray mesh.obj: the mesh framed and lit, said in one line"
+else bad "./ray ball.obj: exit $rc, $(cat "$TMP/err")"; fi
