@@ -1,7 +1,7 @@
 # kdtree.c, bvh.c and grid.c: zero warnings, and each structure's nearest
 # and any-hit queries equal to brute force (tests/test_accel.c) on every
 # test scene.  make test shoots ACCEL_RAYS rays per structure and scene
-# (default 60000, so that make test stays within 90 s on 2 cores); make
+# (default 50000, so that make test stays within 90 s on 2 cores); make
 # stress, which CI also runs, shoots 10^6 and more (tests/stress.sh).
 . tests/lib.sh
 
@@ -24,7 +24,7 @@ if ! $CC $CFLAGS -o "$TMP/test_accel" tests/test_accel.c kdtree.c bvh.c grid.c -
   bad "test_accel builds: $(head -c 300 "$TMP/cc.err" | tr '\n' ' ')"
   exit 1
 fi
-export ACCEL_RAYS=${ACCEL_RAYS:-60000}
+export ACCEL_RAYS=${ACCEL_RAYS:-50000}
 
 # Two runs at a time, one per core; the lines are printed in a fixed order.
 structures="kd bvh-sah bvh-median grid"
