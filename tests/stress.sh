@@ -5,7 +5,8 @@
 # scene (make spd) rendered with each of --accel kd, bvh, grid and none, the
 # same bytes; the same output from 1, 2 and 3 threads on every SPD scene
 # (those make spd writes; SPD=DIR for others).  Ends with "N passed, N
-# failed, N skipped" like make test.
+# failed, N skipped" like make test.  And test_ray's random checks with
+# ten times make test's rays.
 cd "$(dirname "$0")/.." || exit 2
 . tests/lib.sh
 pass=0 fail=0 skipped=0
@@ -42,6 +43,16 @@ for f in scenes/spd/*.nff; do
     || echo "FAIL $n: the structures' pictures differ"
 done > "$TMP/spd_acc.all"
 count < "$TMP/spd_acc.all"
+# ray.c's random checks (watertightness, every structure against the loop)
+# with all their rays, in the double and the float build; make test shoots a tenth.
+$CC $CFLAGS -std=c99 -o "$TMP/test_ray" tests/test_ray.c $RAY_PARTS -lm || exit 2
+$CC $CFLAGS -std=c99 -DREAL=float -o "$TMP/test_ray_float" tests/test_ray.c $RAY_PARTS -lm || exit 2
+for b in test_ray test_ray_float; do
+  ( RAY_TEST_FULL=1 "$TMP/$b" > "$TMP/$b.txt" 2>/dev/null || echo "FAIL $b with RAY_TEST_FULL=1 exited $?" >> "$TMP/$b.txt" ) &
+done
+wait
+grep -h -E '^FAIL |^(PASS|SKIP) .*(watertight|mismatches)' "$TMP/test_ray.txt" "$TMP/test_ray_float.txt" > "$TMP/ray_full.all"
+count < "$TMP/ray_full.all"
 spd=${SPD:-scenes/spd}
 if [ -d "$spd" ]; then
   for f in "$spd"/*.nff; do

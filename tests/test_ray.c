@@ -34,6 +34,11 @@ static int load_or_fail(Scene *s, const char *file, const char *name)
 
 static int near(double a, double b, double tol) { return fabs(a - b) <= tol; }
 
+/* The rays a random check shoots: a tenth of `full` in make test, all of
+ * them when RAY_TEST_FULL is set (make stress), where the rare miss at an
+ * edge has ten times the chance to show. */
+static int rays(int full) { return getenv("RAY_TEST_FULL") ? full : full / 10; }
+
 static void test_vectors(void)
 {
     vec a = v3(1, 2, 3), b = v3(-4, 5, 0.5), c = cross(a, b), u = unit(b);
@@ -296,7 +301,7 @@ static void test_watertight(int shared, double far)
     Scene s = tri_scene(0);
     Worker wk;
     unsigned long long x = 42;
-    int r, escapes = 0, n = 1000000;
+    int r, escapes = 0, n = rays(1000000);
     char name[96];
     memset(&wk, 0, sizeof wk);
     uv_sphere(&s, 8, 16, shared);
@@ -374,8 +379,9 @@ static void test_sphere_clip(void)
 /* Each structure (kd, bvh, grid) must give what the loop gives: same
  * object, same t, bit for bit, for a scene of spheres and triangles and
  * rays of every awkward kind. */
-static void test_tree_matches_loop(const char *accel, int n)
+static void test_tree_matches_loop(const char *accel, int full)
 {
+    int n = rays(full);
     Scene s = tri_scene(0);
     Worker wk;
     unsigned long long x = 7;
