@@ -1,6 +1,7 @@
 # tests/run.sh itself: in a tree of four made-up scripts (one passes, one
 # skips and says why, one fails, one crashes without a FAIL line) it prints
-# each line under its script's name and ends "1 passed, 2 failed, 1 skipped".
+# each line under its script's name and ends "1 passed, 2 failed, 1 skipped";
+# and it prints a line as it comes, not when its script ends.
 . tests/lib.sh
 mkdir -p "$TMP/tree/tests"
 cp tests/run.sh "$TMP/tree/tests/"
@@ -16,3 +17,19 @@ if [ "$(printf '%s\n' "$out" | tail -n 1)" = "1 passed, 2 failed, 1 skipped" ] \
 else
   bad "tests/run.sh's summary: $(printf '%s\n' "$out" | tr '\n' '|')"
 fi
+
+# Lines as they come: a script prints a PASS line and then waits until the
+# line has reached run.sh's output (or 20 s pass); the test waits 10 s for
+# the line, so it sees it only if run.sh passes it on before the script ends.
+mkdir -p "$TMP/live/tests"
+cp tests/run.sh "$TMP/live/tests/"
+printf 'echo "PASS early"; i=0; while [ ! -e "%s" ] && [ $i -lt 200 ]; do sleep 0.1; i=$((i+1)); done\n' \
+  "$TMP/go" >"$TMP/live/tests/e.test.sh"
+bash "$TMP/live/tests/run.sh" >"$TMP/live.out" 2>&1 &
+i=0
+while ! grep -q '^e: PASS early$' "$TMP/live.out" && [ $i -lt 100 ]; do sleep 0.1; i=$((i+1)); done
+grep -q '^e: PASS early$' "$TMP/live.out" && seen=1 || seen=0
+touch "$TMP/go"
+wait
+[ $seen = 1 ] && ok "tests/run.sh prints a result line while its script still runs" \
+  || bad "tests/run.sh held back a line until its script ended: $(tr '\n' '|' <"$TMP/live.out")"

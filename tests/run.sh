@@ -7,8 +7,9 @@
 # look like success.  The last line is "N passed, N failed, N skipped".
 cd "$(dirname "$0")/.." || exit 2
 # The scripts run side by side, TEST_JOBS at a time (default: one per
-# core), the longest first; their lines are printed in the scripts' own
-# order when all are done, so the output does not depend on the timing.
+# core), the longest first.  Each result line is printed as it comes,
+# after the name of its script; when all are done, the failures are
+# listed again under the summary, in the scripts' own order.
 jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 out=$(mktemp -d "${TMPDIR:-/tmp}/testrun.XXXXXX")
 trap 'rm -rf "$out"' EXIT
@@ -20,23 +21,25 @@ done
 for t in $scripts; do
   while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n 2>/dev/null || sleep 0.1; done
   n=$(basename "$t" .test.sh)
-  ( bash "$t" >"$out/$n.out" 2>&1; echo $? >"$out/$n.rc" ) &
+  ( bash "$t" 2>&1 | tee "$out/$n.out" | grep --line-buffered -E '^(PASS|FAIL|SKIP) ' | sed -u "s|^|$n: |"
+    echo "${PIPESTATUS[0]}" >"$out/$n.rc" ) &
 done
 wait
 pass=0 fail=0 skipped=0
 for t in tests/*.test.sh; do
   n=$(basename "$t" .test.sh)
   rc=$(cat "$out/$n.rc")
-  grep -E '^(PASS|FAIL|SKIP) ' "$out/$n.out" | sed "s|^|$n: |"
+  grep -E '^FAIL ' "$out/$n.out" | sed "s|^|$n: |" >>"$out/failures"
   p=$(grep -c '^PASS ' "$out/$n.out")
   f=$(grep -c '^FAIL ' "$out/$n.out")
   k=$(grep -c '^SKIP ' "$out/$n.out")
   if [ "$rc" != 0 ] && [ "$f" = 0 ]; then
-    echo "$n: FAIL script exited $rc; its last lines:"
-    tail -n 5 "$out/$n.out" | sed 's/^/    /'
+    { echo "$n: FAIL script exited $rc; its last lines:"
+      tail -n 5 "$out/$n.out" | sed 's/^/    /'; } >>"$out/failures"
     f=1
   fi
   pass=$((pass + p)) fail=$((fail + f)) skipped=$((skipped + k))
 done
+if [ -s "$out/failures" ]; then echo; echo "failed:"; cat "$out/failures"; fi
 echo "$pass passed, $fail failed, $skipped skipped"
 [ "$fail" = 0 ]
