@@ -39,7 +39,8 @@ static void put_escaped(FILE *f, const char *s)
 
 static int fail(Where w, const char *msg, const char *arg)
 {
-    fprintf(stderr, "%s:%d: %s", w.file, w.line, msg);
+    if (w.line) fprintf(stderr, "%s:%d: %s", w.file, w.line, msg);
+    else fprintf(stderr, "%s: %s", w.file, msg);     /* line 0: the file as a whole */
     if (arg) {
         fputs(": ", stderr);
         put_escaped(stderr, arg);
@@ -339,8 +340,10 @@ int check_size(double fw, double fh, int *width, int *height)
 static int blank(int c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
 /* Splits a line in place into at most max blank-separated tokens; '#'
- * starts a comment.  Returns max + 1 when there are more. */
-static int tokens(char *line, char **tok, int max)
+ * starts a comment.  Returns max + 1 when there are more.  With quotes, a
+ * token in double quotes keeps its blanks and '#' (mesh "my model.obj"),
+ * and a quote left open, or not followed by a blank, gives -1. */
+static int tokens(char *line, char **tok, int max, int quotes)
 {
     int n = 0;
     char *p = line;
@@ -348,6 +351,14 @@ static int tokens(char *line, char **tok, int max)
         while (blank(*p)) p++;
         if (!*p || *p == '#') return n;
         if (n == max) return max + 1;
+        if (quotes && *p == '"') {
+            tok[n++] = ++p;
+            while (*p && *p != '"') p++;
+            if (!*p) return -1;
+            *p++ = 0;
+            if (*p && !blank(*p)) return -1;
+            continue;
+        }
         tok[n++] = p;
         while (*p && *p != '#' && !blank(*p)) p++;
         if (*p == '#') { *p = 0; return n; }
@@ -442,7 +453,7 @@ int read_obj(const scene_builder *b, const char *file, int mat, const char *scen
     w.file = file;
     w.line = 0;
     while (ok && next_line(f, line, OBJ_LINE, &w, &ok)) {
-        int n = tokens(line, tok, max), k, with_normals = 1;
+        int n = tokens(line, tok, max, 0), k, with_normals = 1;
         double x[3];
         if (n == 0) continue;
         if (n > max) ok = fail(w, "too many fields", NULL);
@@ -668,8 +679,9 @@ static int load_sph(const scene_builder *b, FILE *f, Where w)
     char line[4096], *tok[24];
     int ok = 1;
     while (ok && next_line(f, line, sizeof line, &w, &ok)) {
-        int n = tokens(line, tok, 23);
+        int n = tokens(line, tok, 23, 1);
         if (n > 23) ok = fail(w, "too many fields", NULL);
+        else if (n < 0) ok = fail(w, "a quote is left open, or runs into the next field", NULL);
         else if (n == 0) continue;
         else if (strchr("+-.0123456789", tok[0][0])) ok = parse_sphere(b, w, tok, n);
         else ok = parse_keyword(b, w, tok, n);

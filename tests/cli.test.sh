@@ -31,7 +31,7 @@ grep -q ":4: " "$TMP/err" && ok "the line number counts comments and blank lines
 
 rm -f "$TMP/out.ppm"
 ./ray -o "$TMP/out.ppm" "$TMP/missing.sph" 2> "$TMP/err"; rc=$?
-[ $rc -ne 0 ] && grep -qE "^$TMP/missing.sph:0: cannot open scene: No such file" "$TMP/err" && [ ! -e "$TMP/out.ppm" ] \
+[ $rc -ne 0 ] && grep -qE "^$TMP/missing.sph: cannot open scene: No such file" "$TMP/err" && [ ! -e "$TMP/out.ppm" ] \
   && ok "missing file: $(sed "s|$TMP/||" "$TMP/err")" || bad "missing file: exit $rc, said: $(cat "$TMP/err")"
 
 printf '%s\n' "$good" > "$TMP/s.sph"

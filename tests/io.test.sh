@@ -257,7 +257,15 @@ timeout 10 ./ray -o "$TMP/r.ppm" "$TMP/in/fifo.sph" 2> "$TMP/err"; rc=$?
 [ $rc = 1 ] && grep -q "fifo.sph:1: mesh is not a plain file" "$TMP/err" \
   && ok "mesh naming a pipe, which would wait for ever: $(sed "s|$TMP/||g" "$TMP/err")" \
   || bad "mesh naming a pipe: exit $rc (124: it waited), $(sed "s|$TMP/||g" "$TMP/err")"
-refused "a directory as the scene" "$TMP/in" "in:0: read error: Is a directory"
+refused "a directory as the scene" "$TMP/in" "in: read error: Is a directory"
+# A mesh path with blanks or '#' in double quotes; an open quote is refused.
+mkdir "$TMP/in/my models"; cp scenes/ball.obj "$TMP/in/my models/ball #1.obj"
+sed 's|^mesh ball.obj|mesh "my models/ball #1.obj"|' scenes/mesh.sph > "$TMP/in/quoted.sph"
+grep -q '^mesh "my models' "$TMP/in/quoted.sph" \
+  && same_image 'mesh "my models/ball #1.obj": a quoted path keeps its blank and #' "$TMP/in/quoted.sph" scenes/mesh.sph \
+  || bad "quoted.sph was not made"
+printf 'mesh "my models/ball.obj 1 1 1 1 0 0 0 1\n' > "$TMP/in/open.sph"
+refused "a quote left open" "$TMP/in/open.sph" '^.*open.sph:1: a quote is left open'
 printf 'size 8 8\n\001\377\033[31m 1 2 3\n' > "$TMP/in/bin.sph"
 refused "raw bytes in a message are escaped" "$TMP/in/bin.sph" 'bin.sph:2: unknown keyword: \\x01\\xFF\\x1B\[31m'
 LC_ALL=C grep -q '[^[:print:]]' "$TMP/err" && bad "the message above has raw bytes" || ok "the message has no raw byte"
