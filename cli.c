@@ -24,7 +24,8 @@ void usage(FILE *to)
     fputs("usage: ray [options] SCENE\n"
           "Renders SCENE with Whitted ray tracing, or path tracing (--pt): the sphere\n"
           "format (README.md), or NFF (Eric Haines' Neutral File Format, the SPD\n"
-          "scenes') when it ends .nff.\n"
+          "scenes') when it ends .nff; an OBJ mesh alone, framed and lit, when it\n"
+          "ends .obj; - reads the sphere format or NFF from standard input.\n"
           "  -o FILE    output image: PNG if FILE ends .png, PFM (floats) if .pfm, else\n"
           "             PPM (default: SCENE's base name + .ppm; - for stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
@@ -238,8 +239,9 @@ int parse_args(int argc, char **argv, Args *a)
             a->scene = o;
     }
     if (!a->scene) { usage(stderr); return 2; }
-    if (!a->output) a->output = a->made = default_output(a->scene);
-    if (!output_usable(a->output, a->plain) || !apart(a->scene, a->output)) {
+    a->name = strcmp(a->scene, "-") ? a->scene : "stdin";
+    if (!a->output) a->output = a->made = default_output(a->name);
+    if (!output_usable(a->output, a->plain) || (strcmp(a->scene, "-") && !apart(a->scene, a->output))) {
         free(a->made);
         return 2;
     }

@@ -16,6 +16,7 @@
 
 typedef struct {
     const char *scene;      /* the scene file */
+    const char *name;       /* the scene as messages name it: "stdin" for "-" */
     const char *output;     /* -o, or the scene's base name with .ppm */
     const char *accel;      /* --accel: kd, bvh, grid, none, auto; NULL: not given */
     int w, h;               /* -s; 0: the scene's */

@@ -3318,7 +3318,7 @@ static int whitted_draws(const Scene *s)
 static void say_what_is_ignored(const Scene *s, const Args *a)
 {
     const char *black = why_black(s);
-    if (black) fprintf(stderr, "%s: warning: %s\n", a->scene, black);
+    if (black) fprintf(stderr, "%s: warning: %s\n", a->name, black);
     if (s->set.integrator != WHITTED) return;
     if (a->estimator >= 0)
         fprintf(stderr, "ray: warning: --estimator is the path tracer's; Whitted's renderer ignores"
@@ -3366,7 +3366,7 @@ int main(int argc, char **argv)
     ok = load_scene_for(&s, a.scene, strcmp(a.output, "-") ? a.output : NULL);
     if (ok && a.w) { s.set.w = a.w; s.set.h = a.h; }
     load = now() - load;
-    if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", a.scene);
+    if (ok && nobj(&s) == 0) fprintf(stderr, "%s: warning: the scene has no objects\n", a.name);
     if (ok && s.frame)
         fprintf(stderr, "%s: an OBJ mesh alone: grey, seen by a camera framing its box (y up),"
                 " lit by one light\n", a.scene);

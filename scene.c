@@ -946,19 +946,56 @@ static int load_obj_alone(const scene_builder *b, const char *file)
     return 1;
 }
 
+/* Standard input as a file that can be read twice (once to see its
+ * format): a copy in a temporary file, which goes when it is closed. */
+static FILE *copy_of_stdin(void)
+{
+    FILE *f = tmpfile();
+    char buf[8192];
+    size_t n;
+    if (!f) return NULL;
+    while ((n = fread(buf, 1, sizeof buf, stdin)) > 0)
+        if (fwrite(buf, 1, n, f) != n) break;
+    if (ferror(stdin) || ferror(f) || fseek(f, 0, SEEK_SET)) {
+        fclose(f);
+        return NULL;
+    }
+    return f;
+}
+
+/* Whether a scene without a name is NFF: its first word is one of NFF's
+ * entities (v, b, l, f, s, c, p, pp), which are no keywords of the sphere
+ * format, whose lines start with a number or a word.  f is rewound. */
+static int looks_like_nff(FILE *f)
+{
+    static const char *const entities[] = { "v", "b", "l", "f", "s", "c", "p", "pp" };
+    char line[4096], *tok[2];
+    Where w;
+    int ok = 1, n = 0, nff = 0;
+    size_t i;
+    w.file = "stdin";
+    w.line = 0;
+    while (n == 0 && next_line(f, line, sizeof line, &w, &ok)) n = tokens(line, tok, 1, 0);
+    for (i = 0; n >= 1 && i < sizeof entities / sizeof entities[0]; i++) nff |= !strcmp(tok[0], entities[i]);
+    rewind(f);
+    return nff;
+}
+
+/* A scene from its file, or "-": standard input, in the sphere format or
+ * NFF, its meshes named relative to the working directory. */
 int read_scene(const scene_builder *b, const char *file)
 {
+    int from_stdin = !strcmp(file, "-"), ok;
+    FILE *f = from_stdin ? copy_of_stdin() : fopen(file, "r");
     Where w;
-    FILE *f = fopen(file, "r");
-    int ok;
-    w.file = file;
+    w.file = from_stdin ? "stdin" : file;
     w.line = 0;
-    if (!f) return fail(w, "cannot open scene", strerror(errno));
-    if (has_extension(file, ".obj")) {
+    if (!f) return fail(w, from_stdin ? "cannot read standard input" : "cannot open scene", strerror(errno));
+    if (!from_stdin && has_extension(file, ".obj")) {
         fclose(f);
         return load_obj_alone(b, file);
     }
-    ok = has_extension(file, ".nff") ? load_nff(b, f, w) : load_sph(b, f, w);
+    ok = (from_stdin ? looks_like_nff(f) : has_extension(file, ".nff")) ? load_nff(b, f, w) : load_sph(b, f, w);
     if (ok && ferror(f)) ok = fail(w, "read error", strerror(errno));
     fclose(f);
     return ok;

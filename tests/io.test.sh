@@ -258,6 +258,24 @@ timeout 10 ./ray -o "$TMP/r.ppm" "$TMP/in/fifo.sph" 2> "$TMP/err"; rc=$?
   && ok "mesh naming a pipe, which would wait for ever: $(sed "s|$TMP/||g" "$TMP/err")" \
   || bad "mesh naming a pipe: exit $rc (124: it waited), $(sed "s|$TMP/||g" "$TMP/err")"
 refused "a directory as the scene" "$TMP/in" "in: read error: Is a directory"
+# "-" as the scene: standard input, the sphere format or (first statement
+# "v") NFF, from a pipe; meshes relative to the working directory; the
+# image by default stdin.ppm; messages name "stdin".
+cat scenes/whitted.sph | ./ray -s 24x16 -o "$TMP/a.ppm" - 2>"$TMP/err" && ./ray -s 24x16 -o "$TMP/b.ppm" scenes/whitted.sph \
+  && cmp -s "$TMP/a.ppm" "$TMP/b.ppm" && ok "- reads a sphere-format scene from a pipe: the same bytes" \
+  || bad "- with a sphere scene: $(head -2 "$TMP/err")"
+cat scenes/demo.nff | ./ray -s 24x16 -o "$TMP/a.ppm" - 2>"$TMP/err" && ./ray -s 24x16 -o "$TMP/b.ppm" scenes/demo.nff \
+  && cmp -s "$TMP/a.ppm" "$TMP/b.ppm" && ok "- reads an NFF scene from a pipe: the same bytes" \
+  || bad "- with an NFF scene: $(head -2 "$TMP/err")"
+(cd scenes && ../ray -s 24x16 -o "$TMP/a.ppm" - < mesh.sph) 2>"$TMP/err" && ./ray -s 24x16 -o "$TMP/b.ppm" scenes/mesh.sph \
+  && cmp -s "$TMP/a.ppm" "$TMP/b.ppm" && ok "- : a mesh is found relative to the working directory" \
+  || bad "- with a mesh: $(head -2 "$TMP/err")"
+mkdir "$TMP/cwd"
+(cd "$TMP/cwd" && printf 'size 8 8\n0 0 -5 1 1 1 1 1 0 0 0 1\n' | "$OLDPWD/ray" -) 2>"$TMP/err" && [ -s "$TMP/cwd/stdin.ppm" ] \
+  && ok "- without -o writes stdin.ppm" || bad "- without -o: $(ls "$TMP/cwd") $(head -2 "$TMP/err")"
+printf 'size 8 8\nbogus 1\n' | ./ray -o "$TMP/r.ppm" - 2>"$TMP/err"; rc=$?
+[ $rc = 1 ] && grep -q '^stdin:2: unknown keyword: bogus' "$TMP/err" && [ ! -e "$TMP/r.ppm" ] \
+  && ok "- : a message names stdin and the line: $(head -1 "$TMP/err")" || bad "- with a bad line: exit $rc, $(cat "$TMP/err")"
 # A mesh path with blanks or '#' in double quotes; an open quote is refused.
 mkdir "$TMP/in/my models"; cp scenes/ball.obj "$TMP/in/my models/ball #1.obj"
 sed 's|^mesh ball.obj|mesh "my models/ball #1.obj"|' scenes/mesh.sph > "$TMP/in/quoted.sph"
