@@ -16,6 +16,7 @@
 #include <string.h>
 #include <time.h>
 #ifdef RAY_POSIX
+#include <dirent.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -306,12 +307,56 @@ static long process_id(void)
 #endif
 }
 
+#ifdef RAY_POSIX
+/* Whether entry is name's temporary (name.tmp.PID or name.tmp.PID.K, of
+ * the file part base) of a process that is gone: SIGKILL, or a machine
+ * switched off, leaves them, as no handler can run.  A PID that is some
+ * process again keeps its file: it may be another run's. */
+static int stale_temp(const char *entry, const char *base)
+{
+    size_t n = strlen(base);
+    char *end;
+    long pid;
+    if (strncmp(entry, base, n) || strncmp(entry + n, ".tmp.", 5) || !isdigit((unsigned char)entry[n + 5]))
+        return 0;
+    pid = strtol(entry + n + 5, &end, 10);
+    if (*end == '.' && isdigit((unsigned char)end[1])) strtol(end + 1, &end, 10);
+    return !*end && pid > 0 && pid != process_id() && kill((pid_t)pid, 0) != 0 && errno == ESRCH;
+}
+
+/* Removes the stale temporaries beside name, saying so on stderr. */
+static void remove_stale_temps(const char *name)
+{
+    const char *slash = strrchr(name, '/'), *base = slash ? slash + 1 : name;
+    size_t dir = (size_t)(base - name);
+    char *path = malloc(dir + 2 + 256 + 1);
+    DIR *d;
+    struct dirent *e;
+    if (!path) return;
+    if (dir) memcpy(path, name, dir);
+    else path[dir++] = '.', path[dir++] = '/';
+    path[dir] = 0;
+    d = opendir(path);
+    while (d && (e = readdir(d)))
+        if (strlen(e->d_name) <= 256 && stale_temp(e->d_name, base)) {
+            strcpy(path + dir, e->d_name);
+            if (unlink(path) == 0) fprintf(stderr, "ray: removed %s, left by a run that was killed\n", path);
+        }
+    if (d) closedir(d);
+    free(path);
+}
+#endif
+
 /* A temporary file beside name that no other run shares: name.tmp.PID, or
- * name.tmp.PID.K when that exists (left by a run that was killed). */
+ * name.tmp.PID.K when that exists (left by a run that was killed).  Those
+ * of runs that are gone are removed first, where POSIX can tell. */
 static FILE *create_temp(const char *name, char **tmp)
 {
     int k;
     FILE *f = NULL;
+#ifdef RAY_POSIX
+    remove_stale_temps(name);
+#endif
     *tmp = malloc(strlen(name) + 48);
     if (!*tmp) return NULL;
     for (k = 0; k < 100 && !f; k++) {

@@ -82,6 +82,23 @@ for sig in INT TERM HUP QUIT USR1 USR2 ALRM PIPE XCPU XFSZ VTALRM PROF; do
 done
 set +m
 
+# SIGKILL cannot be caught: its temporary stays, and the next run writing
+# beside it removes it (saying so).  Kept: a temporary of a process that
+# still runs (this shell), names that are no temporary of the output, and
+# temporaries of other outputs.
+./ray $big -o "$TMP/out/x.ppm" 2>/dev/null & pid=$!
+wait_for_temp "$TMP/out/x.ppm.tmp.*" 1; kill -KILL $pid; wait $pid 2>/dev/null
+killed=$(ls "$TMP/out" | grep tmp | tr '\n' ' ')
+sh -c 'exit 0' & gone=$!; wait $gone
+touch "$TMP/out/x.ppm.tmp.$gone.2" "$TMP/out/x.ppm.tmp.$$" "$TMP/out/x.ppm.tmp.12x" "$TMP/out/y.ppm.tmp.$gone"
+./ray -s 8x8 -o "$TMP/out/x.ppm" scenes/minray.sph 2>"$TMP/err"
+left=$(ls "$TMP/out" | tr '\n' ' ')
+[ -n "$killed" ] && [ "$left" = "x.ppm x.ppm.tmp.$$ x.ppm.tmp.12x y.ppm.tmp.$gone " ] \
+  && [ "$(grep -c 'left by a run that was killed' "$TMP/err")" = 2 ] \
+  && ok "SIGKILL leaves $killed; the next run removes it and x.ppm.tmp.GONE.2, keeps the rest" \
+  || bad "stale temporaries: killed left '$killed', after the next run: $left; said: $(tr '\n' '|' <"$TMP/err")"
+rm -f "$TMP"/out/*.tmp.*
+
 # -o through a symbolic link: the link's target gets the image, through a
 # temporary beside it renamed over it at the end (so an interrupt leaves the
 # old image whole, not an emptied file); the link stays a link.
