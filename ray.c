@@ -207,7 +207,8 @@ typedef struct {
     vec eye, right, up, fwd;  /* orthonormal frame */
     real tan_half;            /* tan(fov / 2); fov: horizontal, edge to edge */
     real anchor;              /* 0.5: samples centred on the pixel; 0: on its corner */
-    real hither;              /* near clip: nothing nearer than this plane is seen */
+    real hither;              /* near clip: nothing nearer than this plane is seen, */
+    int hither_sphere;        /* or, if set, nearer than this distance from the eye */
     real lens, focus;         /* a thin lens: its radius (0: a pinhole), and the distance
                                * of the plane it brings into focus */
 } Camera;
@@ -939,11 +940,14 @@ static Ray camera_ray(const Camera *c, int w, int h, real x, real y)
     return r;
 }
 
-/* Where a ray from the eye's plane along d meets the near clip (hither),
- * as its t; 0 without one. */
+/* Where a ray from the eye's plane along d (a unit vector) meets the near
+ * clip (hither), as its t; 0 without one.  The clip is a plane, as NFF's
+ * hither is, or a sphere round the eye: smallpt starts its rays 140 along
+ * each unit direction. */
 static real near_clip(const Camera *c, vec d)
 {
-    return c->hither > 0 ? c->hither / dot(d, c->fwd) : 0;
+    if (!(c->hither > 0)) return 0;
+    return c->hither_sphere ? c->hither : c->hither / dot(d, c->fwd);
 }
 
 /* A thin lens (Potmesil and Chakravarty, "A lens and aperture camera model
@@ -3128,7 +3132,7 @@ static void build_setting(void *user, int what, const double *v, const char *wor
     case SET_SIZE: s->set.w = (int)v[0]; s->set.h = (int)v[1]; break;
     case SET_DEPTH: s->set.depth = s->set.max_rays = (int)v[0]; break;
     case SET_SAMPLES: s->set.spp = (int)v[0]; break;
-    case SET_HITHER: s->cam.hither = (real)v[0]; break;
+    case SET_HITHER: s->cam.hither = (real)v[0], s->cam.hither_sphere = v[1] != 0; break;
     case SET_TIR_REFLECT: s->tir_reflect = v[0] != 0; break;
     case SET_PATH: s->set.integrator = v[0] != 0 ? PATH : WHITTED; break;
     case SET_AMBIENT: s->ambient = vec_of(v); break;

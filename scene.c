@@ -583,7 +583,7 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
 {
     double v[17];
     const char *k = tok[0];
-    int mat, ok, size[2], i;
+    int mat, ok, size[2], i, sphere = 0;
     if (!strcmp(k, "accel")) {
         if (ntok != 2 || !accel_name(tok[1]))
             return fail(w, "expected `accel` and one of kd, bvh, grid, none, auto", NULL);
@@ -604,12 +604,18 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
         set(b, SET_LENS, v[0], v[1], 0);
         return 1;
     }
+    if (!strcmp(k, "hither") && ntok == 3) {  /* `hither D sphere`: D from the eye, as smallpt's */
+        if (strcmp(tok[2], "plane") && strcmp(tok[2], "sphere"))
+            return fail(w, "expected `hither D`, `hither D plane` or `hither D sphere`", tok[2]);
+        sphere = !strcmp(tok[2], "sphere");
+        ntok = 2;
+    }
     for (i = 0; i < (int)(sizeof ones / sizeof *ones); i++)
         if (!strcmp(k, ones[i].key)) {
             if (!numbers(w, k, tok, ntok, 1, 1, v)) return 0;
             if (!(v[0] >= ones[i].lo && v[0] <= ones[i].hi && (!ones[i].whole || v[0] == floor(v[0]))))
                 return fail(w, ones[i].rule, tok[1]);
-            set(b, ones[i].what, v[0], 0, 0);
+            set(b, ones[i].what, v[0], sphere, 0);
             return 1;
         }
     if (!strcmp(k, "rough")) {          /* like `sided`: for what follows, until the next */

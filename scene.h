@@ -28,7 +28,7 @@ enum {
     SET_SIZE,           /* v[0] x v[1] pixels */
     SET_DEPTH,          /* v[0]: recursion depth, or the rays of a path */
     SET_SAMPLES,        /* v[0]: samples per pixel */
-    SET_HITHER,         /* v[0]: the near clip */
+    SET_HITHER,         /* v[0]: the near clip; v[1] 1: a sphere round the eye, not a plane */
     SET_TIR_REFLECT,    /* v[0]: 1 past the critical angle kt goes to the mirror, 0 it is lost */
     SET_PATH,           /* v[0]: 1 path tracing, 0 Whitted */
     SET_AMBIENT,        /* v[0..2] */

@@ -921,6 +921,36 @@ static void test_camera(void)
            "%.15g deg, want %g", angle, 30);
 }
 
+/* smallpt starts its rays 140 along each unit direction from the eye
+ * (`hither 140 sphere`), not on a plane 140 along the view: every ray's
+ * near clip is 140, the image's corner ray clipped as much as its centre.
+ * With the plane, the top row of scenes/smallpt.sph reaches the lamp
+ * (which pokes through the ceiling), which smallpt never shows there. */
+static void test_hither_sphere(void)
+{
+    Scene s;
+    Worker wk;
+    Hit h;
+    int x, W = 1024, H = 768, lamp = 0, off = 0;
+    memset(&wk, 0, sizeof wk);
+    if (!load_or_fail(&s, "scenes/smallpt.sph", "hither 140 sphere")) return;
+    build_accel(&s, "kd");
+    for (x = 0; x < W; x++) {
+        Ray r = camera_ray(&s.cam, W, H, x + (real)0.5, (real)0.5);
+        off += r.tmin != 140;
+        if (nearest_hit(&s, r, &h, &wk)) lamp += s.mat[h.mat].kl > 0;
+    }
+    report(off == 0 && lamp == 0, "hither 140 sphere (smallpt's): each ray clipped at 140, the top row sees no lamp",
+           "%g rays clipped elsewhere, %g see the lamp", off, lamp);
+    s.cam.hither_sphere = 0;
+    for (lamp = 0, x = 0; x < W; x++) {
+        Ray r = camera_ray(&s.cam, W, H, x + (real)0.5, (real)0.5);
+        if (nearest_hit(&s, r, &h, &wk)) lamp += s.mat[h.mat].kl > 0;
+    }
+    report(lamp > W / 2, "hither 140 as a plane: the top row sees the lamp", "%g of %g pixels", lamp, W);
+    free_scene(&s);
+}
+
 /* Does a ray spawned at h towards dir hit h's own object again?  Shadow
  * rays skip the surface they leave when it is flat or they leave a sphere
  * outward, so the acne tests below ask this too, with the skip switched off:
@@ -1069,6 +1099,7 @@ int main(void)
     test_sphere_inside_and_miss();
     test_refraction();
     test_camera();
+    test_hither_sphere();
     test_no_nan();
     test_triangle_scales();
     test_triangle_degenerate();
