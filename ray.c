@@ -980,6 +980,17 @@ static Ray through_lens(const Camera *c, Ray r, real u1, real u2)
 
 static int within_far_limit(vec p) { return maxabs(p) <= FAR_LIMIT; }
 
+/* A sphere of centre c and radius r, or a cone's end, within FAR_LIMIT as
+ * the camera and the lights are: a sphere's squared radius overflows past
+ * 1.3e154, and it would vanish.  0 and why if not. */
+static int within_far_limit_by(vec c, real r, char *why)
+{
+    if (maxabs(c) + r <= FAR_LIMIT) return 1;
+    sprintf(why, "object too far out or too large: beyond %.2g (a centre plus its radius), its squared"
+            " distances overflow and it would vanish", (double)FAR_LIMIT);
+    return 0;
+}
+
 /* a times the power of two that brings its largest coordinate into
  * [1/2, 1): the same direction, and exactly the same unit() and cross()
  * bits as a itself, yet no square of it overflows or underflows. */
@@ -2440,6 +2451,7 @@ static int add_checked_cone(Scene *s, vec base, real rb, vec apex, real ra, int 
 {
     if (!(rb >= 0 && ra >= 0 && rb + ra > 0))
         return sprintf(why, "cone radii must be >= 0 and not both 0"), 0;
+    if (!within_far_limit_by(base, rb, why) || !within_far_limit_by(apex, ra, why)) return 0;
     if (!(dot(sub(apex, base), sub(apex, base)) > 0))
         return sprintf(why, "cone base and apex coincide"), 0;
     /* Shorter than this, the rounding of a point's height along the axis
@@ -3091,7 +3103,7 @@ static int build_material(void *user, const scene_material *m, char *why)
 
 static int build_sphere(void *user, const double c[3], double r, int mat, char *why)
 {
-    (void)why;
+    if (!within_far_limit_by(vec_of(c), (real)r, why)) return 0;
     add_sphere(user, vec_of(c), (real)r, mat);
     return 1;
 }
@@ -3102,7 +3114,21 @@ static int build_cone(void *user, const double base[3], double rb, const double 
     return add_checked_cone(user, vec_of(base), (real)rb, vec_of(apex), (real)ra, mat, why);
 }
 
-static int build_vertex(void *user, const double p[3]) { return add_vertex(user, vec_of(p)); }
+/* A triangle's vertices lie within VERTEX_LIMIT.  degenerate() multiplies
+ * four lengths in doubles, which overflows past legs of 1e77 (the triangle
+ * then has no area and vanishes); in the float build, its hit test loses
+ * triangles with legs of 2e10 (both measured, the camera 3 sizes away). */
+#define VERTEX_LIMIT (sizeof(real) == sizeof(float) ? 1e9 : 1e76)
+
+static int build_vertex(void *user, const double p[3], char *why)
+{
+    if (!(fmax(fabs(p[0]), fmax(fabs(p[1]), fabs(p[2]))) <= VERTEX_LIMIT)) {
+        sprintf(why, "vertex too far out: beyond %.2g, a triangle's arithmetic overflows and it would vanish",
+                VERTEX_LIMIT);
+        return -1;
+    }
+    return add_vertex(user, vec_of(p));
+}
 static int build_normal(void *user, const double n[3]) { return add_normal(user, vec_of(n)); }
 static void build_vertex_at(void *user, int i, double p[3]) { to3(((Scene *)user)->vert[i], p); }
 

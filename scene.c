@@ -49,6 +49,16 @@ static int fail(Where w, const char *msg, const char *arg)
     return 0;
 }
 
+/* A vertex to the builder: its index, or -1 after the builder's message
+ * (a vertex beyond what its arithmetic keeps). */
+static int vertex(const scene_builder *b, Where w, const double p[3])
+{
+    char why[SCENE_WHY];
+    int k = b->vertex(b->user, p, why);
+    if (k < 0) fail(w, why, NULL);
+    return k;
+}
+
 /* One finite number from a token, rounded to the renderer's precision, or
  * a message saying what is wrong. */
 static int number(Where w, const char *tok, double *out)
@@ -462,7 +472,7 @@ int read_obj(const scene_builder *b, const char *file, int mat, const char *scen
             /* a vertex may go on with w, or with a colour: both unused */
             ok = numbers(w, tok[0], tok, normal || n < 4 ? n : 4, 1, 3, x);
             if (ok && normal && (k = b->normal(b->user, x)) >= 0 && !nn++) n0 = k;
-            if (ok && !normal && (k = b->vertex(b->user, x)) >= 0 && !nv++) v0 = k;
+            if (ok && !normal && (ok = (k = vertex(b, w, x)) >= 0) && !nv++) v0 = k;
         } else if (!strcmp(tok[0], "f")) {
             if (n < 4) ok = fail(w, "a face needs 3 corners or more", NULL);
             for (k = 1; k < n && ok; k++) {
@@ -659,9 +669,8 @@ static int parse_keyword(const scene_builder *b, Where w, char **tok, int ntok)
     if (!strcmp(k, "tri")) {
         int c[3], none[3] = { -1, -1, -1 };
         if (!numbers(w, k, tok, ntok, 1, 17, v) || !card_material(b, w, v + 9, &mat)) return 0;
-        c[0] = b->vertex(b->user, v);
-        c[1] = b->vertex(b->user, v + 3);
-        c[2] = b->vertex(b->user, v + 6);
+        for (i = 0; i < 3; i++)
+            if ((c[i] = vertex(b, w, v + 3 * i)) < 0) return 0;
         b->triangle(b->user, c, none, mat);
         return 1;
     }
@@ -795,7 +804,7 @@ static int nff_polygon(const scene_builder *b, Lexer *lx, int normals, int mat)
     for (k = 0; k < n && ok; k++) {
         ok = nff_numbers(lx, "a polygon", normals ? 6 : 3, x);
         if (!ok) break;
-        vi[k] = b->vertex(b->user, x);
+        ok = (vi[k] = vertex(b, lx->w, x)) >= 0;
         if (normals) ni[k] = b->normal(b->user, x + 3);
     }
     if (ok) triangulate(b, vi, normals ? ni : NULL, n, mat);

@@ -58,7 +58,7 @@ typedef struct {
     int (*sphere)(void *user, const double centre[3], double radius, int mat, char *why);
     int (*cone)(void *user, const double base[3], double rbase, const double apex[3],
                 double rapex, int mat, char *why);
-    int (*vertex)(void *user, const double p[3]);           /* its index */
+    int (*vertex)(void *user, const double p[3], char *why); /* its index, or -1 */
     int (*normal)(void *user, const double n[3]);           /* its index */
     void (*vertex_at)(void *user, int i, double p[3]);      /* vertex i as it is kept */
     /* corners v[0..2], normals n[0..2] (n[0] < 0: none, shade flat) */
