@@ -3343,12 +3343,38 @@ static int whitted_draws(const Scene *s)
     return any;
 }
 
-/* Said once before the render: a picture that will be black, and the
- * path tracer's options given to Whitted's renderer, which ignores them. */
+/* The first point light inside an opaque sphere (kt 0, at rest) that the
+ * eye is outside of: it lights only that sphere's inside, which the eye
+ * never sees.  -1: none.  *in is the sphere.  A light and an eye both
+ * inside one sphere, a room or a sky made of it, are as they should be. */
+static int buried_light(const Scene *s, int *in)
+{
+    int i, k;
+    for (i = 0; i < s->nlight; i++)
+        for (k = 0; k < s->nsph && s->light[i].sphere < 0; k++) {
+            const Sphere *b = &s->sph[k];
+            vec l = sub(s->light[i].pos, b->cen), e = sub(s->cam.eye, b->cen);
+            if (s->mat[b->mat].kt == 0 && !nonzero(b->move) && dot(l, l) < b->rad * b->rad
+                && dot(e, e) > b->rad * b->rad)
+                return *in = k, i;
+        }
+    return -1;
+}
+
+/* Said once before the render: a picture that will be black, a light no
+ * one will see the work of, and the path tracer's options given to
+ * Whitted's renderer, which ignores them. */
 static void say_what_is_ignored(const Scene *s, const Args *a)
 {
     const char *black = why_black(s);
+    int in, l = buried_light(s, &in);
     if (black) fprintf(stderr, "%s: warning: %s\n", a->name, black);
+    if (l >= 0)
+        fprintf(stderr, "%s: warning: the light at (%g %g %g) lies inside an opaque sphere (centre %g %g %g,"
+                " radius %g) that the eye is outside of: it lights nothing the camera sees\n", a->name,
+                (double)s->light[l].pos.x, (double)s->light[l].pos.y, (double)s->light[l].pos.z,
+                (double)s->sph[in].cen.x, (double)s->sph[in].cen.y, (double)s->sph[in].cen.z,
+                (double)s->sph[in].rad);
     if (s->set.integrator != WHITTED) return;
     if (a->estimator >= 0)
         fprintf(stderr, "ray: warning: --estimator is the path tracer's; Whitted's renderer ignores"

@@ -236,7 +236,8 @@ printf 'v\nfrom 0 -5 0\nat 0 0 0\nup 0 0 1\nangle 40\nhither 1\nresolution 8 8\n
   && ok "NFF: a negative background is refused at its line" || bad "NFF negative background: exit $rc, $(cat "$TMP/err")"
 
 # Warnings, once each, naming the file: an albedo above 1; a picture that
-# will be black; the path tracer's options given to Whitted's renderer.
+# will be black; a light buried in a ball; the path tracer's options given
+# to Whitted's renderer.
 printf '0 0 0  5 1 1  1  1 0 0 0 1\nlight 0 -5 0  1 1 1\n' > "$TMP/w.sph"
 ./ray --pt -s 4x4 -o "$TMP/w.ppm" "$TMP/w.sph" 2>"$TMP/err"; rc=$?
 [ $rc = 0 ] && [ "$(grep -c "w.sph:1: warning: kd times the colour = 5 exceeds 1" "$TMP/err")" = 1 ] \
@@ -251,6 +252,17 @@ printf 'camera 0 -5 0  0 0 0  0 0 1  40\n0 0 0  1 1 1  1  1 0 0 0 1\n' > "$TMP/d
 ./ray -s 4x4 -o "$TMP/w.ppm" scenes/cornell.sph --whitted 2>"$TMP/err"
 ! grep -q "warning: no light" "$TMP/err" && ok "the Cornell box in Whitted's renderer: lit by its lamp, no warning" \
   || bad "Cornell, Whitted: $(cat "$TMP/err")"
+# A light inside an opaque ball the eye is outside of is warned about; not
+# one inside a glass ball, nor one in a room made of a sphere's inside.
+printf 'camera 0 -5 0  0 0 0  0 0 1  40\nlight 0 0 0  1 1 1\n0 0 0  1 1 1  1  1 0 0 0 1\n' > "$TMP/buried.sph"
+./ray -s 4x4 -o "$TMP/w.ppm" "$TMP/buried.sph" 2>"$TMP/err"
+[ "$(grep -c "buried.sph: warning: the light at (0 0 0) lies inside an opaque sphere" "$TMP/err")" = 1 ] \
+  && ok "a light inside an opaque ball: warned, naming the file" || bad "light in a ball: $(cat "$TMP/err")"
+sed 's/1  1 0 0 0 1$/1  0 .1 .9 0 1.5/' "$TMP/buried.sph" > "$TMP/glass.sph"
+sed 's/1  1 0 0 0 1$/50  1 0 0 0 1/' "$TMP/buried.sph" > "$TMP/room.sph"
+./ray -s 4x4 -o "$TMP/w.ppm" "$TMP/glass.sph" 2>"$TMP/err"; ./ray -s 4x4 -o "$TMP/w.ppm" "$TMP/room.sph" 2>>"$TMP/err"
+grep -q "1.5$" "$TMP/glass.sph" && grep -q " 50 " "$TMP/room.sph" && ! grep -q "opaque sphere" "$TMP/err" \
+  && ok "a light inside a glass ball, or in a room with the eye: no warning" || bad "glass or room: $(cat "$TMP/err")"
 ./ray --estimator nee -s 4x4 -o "$TMP/w.ppm" scenes/whitted.sph 2>"$TMP/err"
 [ "$(grep -c "warning: --estimator is the path tracer's" "$TMP/err")" = 1 ] \
   && ok "--estimator given to Whitted's renderer: warned" || bad "--estimator, Whitted: $(cat "$TMP/err")"
