@@ -568,7 +568,6 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
                              : pixel_color(s, i, j, spp, wk));
 }
 
-
 /* The pixel's colour: RayTrace of each of its spp samples, averaged. */
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
 {
@@ -3060,14 +3059,6 @@ static int add_material(Scene *s, Material m)
     return s->nmat++;
 }
 
-
-
-
-
-
-
-
-
 /* A point light, within FAR_LIMIT. */
 static int point_light(Scene *s, vec pos, vec color, char *why)
 {
@@ -3079,8 +3070,6 @@ static int point_light(Scene *s, vec pos, vec color, char *why)
     add_light(s, pos, color, -1);
     return 1;
 }
-
-
 
 /* The builder's calls (scene.h): what scene.c read, into the Scene. */
 static vec vec_of(const double *p) { return v3((real)p[0], (real)p[1], (real)p[2]); }
@@ -3217,7 +3206,6 @@ static void default_scene(Scene *s)
     set_camera(s, v, why);
 }
 
-
 /* The scene in file, read by scene.c, for a render that writes output
  * (which no mesh the scene names may be; NULL: no output); 0 after a
  * message. */
@@ -3262,8 +3250,6 @@ static int load_scene_for(Scene *s, const char *file, const char *output)
 }
 
 #define load_scene(s, file) load_scene_for(s, file, NULL)    /* for the tests: no output */
-
-
 
 /* Objects that glow (kl > 0): the path tracer's area lights, and for
  * Whitted's the spheres that are lights. */
