@@ -922,17 +922,27 @@ static int load_nff(const scene_builder *b, FILE *f, Where w)
     return ok;
 }
 
-/* Does name end with ext (given in lower case), in any case? */
+/* Do paths a and b name one file?  Under POSIX by device and inode (through
+ * links, however spelled).  Under Windows by the full path, in any case: its
+ * file systems ignore case, so "x.sph", "./X.SPH" and "C:\\dir\\x.sph" are one
+ * file there (not through links).  Elsewhere by name. */
 int same_file(const char *a, const char *b)
 {
-#ifdef RAY_POSIX
+#if defined(RAY_POSIX)
     struct stat x, y;
     return stat(a, &x) == 0 && stat(b, &y) == 0 && x.st_dev == y.st_dev && x.st_ino == y.st_ino;
+#elif defined(_WIN32)
+    char *x = _fullpath(NULL, a, 0), *y = _fullpath(NULL, b, 0);
+    int same = x && y ? !_stricmp(x, y) : !strcmp(a, b);
+    free(x);
+    free(y);
+    return same;
 #else
     return !strcmp(a, b);
 #endif
 }
 
+/* Does name end with ext (given in lower case), in any case? */
 int has_extension(const char *name, const char *ext)
 {
     size_t n = strlen(name), k = strlen(ext), i;

@@ -100,6 +100,6 @@ const char *accel_name(const char *name);
 const char *file_part(const char *path);             /* the name after the directories */
 char *beside(const char *scene, const char *name);   /* name relative to scene's directory */
 int has_extension(const char *name, const char *ext);/* ext in lower case, in any case */
-int same_file(const char *a, const char *b);         /* through links, however spelled (POSIX) */
+int same_file(const char *a, const char *b);         /* POSIX: through links; Windows: any case */
 
 #endif
