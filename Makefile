@@ -1,6 +1,7 @@
 # make          build everything with -O2 (override: make CC=clang CFLAGS=-O3)
 # make test     the test suite; ends with "N passed, N failed, N skipped"
 # make stress   longer runs than make test: more rays for every acceleration structure, every SPD scene
+# make wine     ray.exe (mingw-w64) run under Wine, its images byte for byte against ./ray's (tests/wine.sh)
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)
 # make spd      the seven SPD scenes at the benchmark's sizes, generated into scenes/spd/
@@ -89,6 +90,9 @@ test: all
 stress: all spd
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" RAY_PARTS="$(RAY_PARTS)" bash tests/stress.sh
 
+wine: ray
+	@CFLAGS="$(CFLAGS)" RAY_PARTS="$(RAY_PARTS)" bash tests/wine.sh
+
 bench: all spd
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash bench/run.sh
 
@@ -98,5 +102,5 @@ clean:
 
 FORCE:
 
-.PHONY: all test stress bench clean golf spd fuzz FORCE
+.PHONY: all test stress wine bench clean golf spd fuzz FORCE
 -include golf/golf.mk
