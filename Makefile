@@ -8,7 +8,9 @@
 # make fuzz     libFuzzer on the scene readers (clang; fuzz/): builds build/fuzz/fuzz_sph,
 #               fuzz_nff and fuzz_obj and runs each FUZZ_SECONDS (60; FUZZ_SECONDS=600 for longer;
 #               FUZZ_SEED=N for libFuzzer's -seed)
-# make clean    the programs, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm)
+# make install  ./ray and its manual page ray.1 into $(DESTDIR)$(PREFIX)/bin and
+#               $(DESTDIR)$(PREFIX)/share/man/man1 (PREFIX=/usr/local); make uninstall removes them
+# make clean    the programs, ray.1, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm)
 CC     ?= cc
 CFLAGS ?= -O2
 LDLIBS  = -lm
@@ -22,7 +24,7 @@ FP     := $(shell echo 'int main(void){return 0;}' | $(CC) -ffp-contract=off -x 
 
 PROGS = ray minray tools/ppmdiff tools/spd
 
-all: $(PROGS)
+all: $(PROGS) ray.1
 
 # ray.c is the tracer; the files beside it read scenes (scene.c), write
 # images (image.c), read the command line (cli.c) and find hits (kdtree.c,
@@ -33,6 +35,14 @@ RAY_HEADERS = posix.h scene.h image.h cli.h kdtree.h bvh.h grid.h prims.h
 
 ray: ray.c $(RAY_PARTS) $(RAY_HEADERS)
 	$(CC) $(CFLAGS) $(FP) $(OMP) -o $@ ray.c $(RAY_PARTS) $(LDLIBS)
+
+# ray's manual page, made from the one copy of each text: ./ray --help (cli.c's)
+# for the options, the README's sentences for the rest (tools/man.awk); its
+# date the last commit's (outside git, today).
+ray.1: ray README.md tools/man.awk
+	./ray --help | awk -v version="$$(./ray --version)" -v readme=README.md \
+	  -v date="$$(git log -1 --date=short --format=%cd 2>/dev/null || date +%Y-%m-%d)" -f tools/man.awk >$@.tmp \
+	  && mv $@.tmp $@ || { rm -f $@.tmp; exit 1; }
 
 # The card is K&R C with implicit int: -w keeps its historical text quiet.
 minray: minray.c
@@ -93,14 +103,32 @@ stress: all spd
 wine: ray
 	@CFLAGS="$(CFLAGS)" RAY_PARTS="$(RAY_PARTS)" bash tests/wine.sh
 
+# What a user runs: ray and its page.  Not minray, the 1987 card: it takes
+# no options and prints the one 32x32 image to stdout, which ./ray
+# scenes/minray.sph renders too; it is a piece of history to read (minray.c)
+# more than a command to keep on the PATH.
+PREFIX ?= /usr/local
+BINDIR  = $(PREFIX)/bin
+MAN1DIR = $(PREFIX)/share/man/man1
+
+install: ray ray.1
+	mkdir -p $(DESTDIR)$(BINDIR) $(DESTDIR)$(MAN1DIR)
+	cp ray $(DESTDIR)$(BINDIR)/ray
+	chmod 755 $(DESTDIR)$(BINDIR)/ray
+	cp ray.1 $(DESTDIR)$(MAN1DIR)/ray.1
+	chmod 644 $(DESTDIR)$(MAN1DIR)/ray.1
+
+uninstall:
+	rm -f $(DESTDIR)$(BINDIR)/ray $(DESTDIR)$(MAN1DIR)/ray.1
+
 bench: all spd
 	@CC="$(CC)" CFLAGS="$(CFLAGS)" bash bench/run.sh
 
 clean:
-	rm -rf $(PROGS) build bench/out scenes/spd
+	rm -rf $(PROGS) ray.1 build bench/out scenes/spd
 	rm -f *.ppm *.png *.pfm
 
 FORCE:
 
-.PHONY: all test stress wine bench clean golf spd fuzz FORCE
+.PHONY: all test stress wine install uninstall bench clean golf spd fuzz FORCE
 -include golf/golf.mk
