@@ -4,8 +4,8 @@
 # has it; -static, so that it needs no DLL of the compiler's), run under Wine,
 # and its files are compared byte for byte with ./ray's on Linux: the card's
 # scene, a path-traced one, a PNG and a PFM; then what Windows does its own
-# way: stdout in binary mode, the rename over an existing file, and the scene
-# as -o in another spelling.  Not a *.test.sh, so not in make test: Wine may
+# way: a scene on stdin, stdout in binary mode, the rename over an existing
+# file, and the scene as -o in another spelling.  Not a *.test.sh, so not in make test: Wine may
 # be absent, and its first start makes a new prefix (some 700 MB, about 5 s);
 # .ci/run runs it after the mingw-w64 build.  Lines "PASS ", "FAIL ",
 # "SKIP ", then "N passed, N failed, N skipped"; exit 1 on a failure.
@@ -94,6 +94,16 @@ same "a PNG (-s 64x48 --gamma scenes/whitted.sph)" whitted.png \
   scenes/whitted.sph scenes/whitted.sph -s 64x48 --gamma
 same "a PFM of the mesh scene, its OBJ found beside scenes\\mesh.sph" mesh.pfm \
   scenes/mesh.sph 'scenes\mesh.sph' -s 48x36
+
+# The scene on standard input (-), as Windows hands it over (text mode:
+# a scene's lines are text), and the image on standard output.
+./ray -s 16x16 -o "$TMP/lin/stdin.ppm" - <scenes/minray.sph 2>/dev/null
+win -s 16x16 -o - - <scenes/minray.sph 2>/dev/null | cat >"$TMP/win/stdin.ppm"
+if [ -s "$TMP/lin/stdin.ppm" ] && cmp -s "$TMP/lin/stdin.ppm" "$TMP/win/stdin.ppm"; then
+  ok "ray -o - - <scenes/minray.sph: the scene from stdin, the image to stdout, the same bytes"
+else
+  bad "ray -o - - <scenes/minray.sph: $(cmp "$TMP/lin/stdin.ppm" "$TMP/win/stdin.ppm" 2>&1 | head -n 1)"
+fi
 
 # Binary stdout: P6 bytes (0x0a among them) and P3's lines through a pipe,
 # no \r added (ray.exe sets stdout's mode to binary for -o -).
