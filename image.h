@@ -1,5 +1,5 @@
 /* image.h - the image being made, and the files it is written to: PPM
- * (P6, or plain P3), PNG (8-bit RGB, stored without compression) and PFM
+ * (P6, or plain P3), PNG (8-bit RGB, deflate-compressed) and PFM
  * (32-bit floats, the radiance itself).
  *
  * An output is opened before the render and written after it, through a

@@ -1,0 +1,88 @@
+# Images people can open and keep (issue 22, section 4): PNG compressed by
+# image.c's own deflate.  Every check prints PASS, FAIL or SKIP
+# (tests/lib.sh).  The images are made first and then checked by one python
+# process (tests/png2ppm.py's decode()): a python
+# start costs a tenth of a second here.
+. tests/lib.sh
+
+# tools/ppm2png: a PPM through the same PNG writer (image.c).
+$CC -std=c99 $CFLAGS -o "$TMP/ppm2png" tools/ppm2png.c image.c 2> "$TMP/err" \
+  || bad "tools/ppm2png.c compiles: $(head -3 "$TMP/err")"
+
+# --- PNG.  Renders as PNG and PPM: a pixel, a row 4000 wide, a column, odd
+# sizes, an NFF scene, path-traced renders whose noise leaves few copies to
+# find, Whitted's with many, and one colour (copies of 258 bytes, the
+# longest, all the way).
+printf 'background .2 .3 .4\n' > "$TMP/flat.sph"
+k=0
+for args in "-s 1x1 scenes/whitted.sph" "-s 4000x1 scenes/whitted.sph" "-s 1x300 scenes/whitted.sph" \
+            "-s 160x120 scenes/demo.nff" "-s 120x90 -n 4 --pt scenes/cornell.sph" "-s 96x64 -n 2 scenes/caustic.sph" \
+            "-s 320x240 --gamma scenes/whitted.sph" "-s 320x240 $TMP/flat.sph"; do
+  k=$((k + 1))
+  ./ray $args -o "$TMP/png$k.ppm" 2> /dev/null && ./ray $args -o "$TMP/png$k.png" 2> /dev/null
+  echo "$args" | sed "s|$TMP/||" > "$TMP/png$k.args"
+done
+# Noise through tools/ppm2png: random bytes, which do not compress (stored
+# blocks), and 640x480 of 5-bit noise, timed (few copies: the longest
+# searches; inflated, not unfiltered: python's unfiltering takes a second).
+python3 -c '
+import random, sys
+for name, w, h, shift in (("noise", 200, 150, 0), ("big", 640, 480, 3)):
+    pixels = bytes(b >> shift for b in random.Random(22).randbytes(w * h * 3))
+    open(sys.argv[1] + "/" + name + ".ppm", "wb").write(b"P6\n%d %d\n255\n" % (w, h) + pixels)' "$TMP"
+"$TMP/ppm2png" "$TMP/noise.ppm" "$TMP/noise.png"
+TIMEFORMAT=%U
+{ time "$TMP/ppm2png" "$TMP/big.ppm" "$TMP/big.png" 2>&1; } 2> "$TMP/big.time"
+
+# Each PNG decoded by png2ppm.decode(): python's zlib inflates it (a bad
+# Huffman table, a wrong length or distance code, a bad block is an error
+# there; the Adler-32 and every CRC are checked) and the rows are
+# unfiltered; the pixels must be the PPM's, byte for byte.  The size
+# against zlib's: python's zlib at level 6 (its default) on the very rows
+# the PNG holds (inflated from its IDAT chunks: the same filter byte chosen
+# for each row), against the PNG's IDAT bytes: within 1.3 times on
+# realistic renders (Whitted's scene at 320x240, a path-traced Cornell box).
+python3 - "$TMP" <<'EOF'
+import os, struct, sys, zlib
+sys.path.insert(0, "tests")
+import png2ppm
+tmp = sys.argv[1]
+def read(name): return open(os.path.join(tmp, name), "rb").read()
+def sizes(png):
+    pos, idat = 8, b""
+    while pos < len(png):
+        n, kind = struct.unpack(">I4s", png[pos:pos + 8])
+        idat += png[pos + 8:pos + 8 + n] if kind == b"IDAT" else b""
+        pos += 12 + n
+    rows = zlib.decompress(idat)
+    return len(idat), len(zlib.compress(rows, 6)), len(rows)
+def decoded(name, want):
+    try:
+        ppm, _ = png2ppm.decode(read(name + ".png"))
+    except SystemExit as e:
+        return str(e)
+    return "" if ppm == want else "decodes to other pixels"
+k = 1
+while os.path.exists(os.path.join(tmp, "png%d.args" % k)):
+    name, args = "png%d" % k, read("png%d.args" % k).decode().strip()
+    why = decoded(name, read(name + ".ppm"))
+    print("%s PNG %s: %s" % ("FAIL" if why else "PASS", args, why or "decodes to the PPM's bytes (%d bytes, the PPM %d)"
+                             % (len(read(name + ".png")), len(read(name + ".ppm")))))
+    ours, zlib6, rows = sizes(read(name + ".png"))
+    if "--gamma" in args or "cornell" in args:
+        print("%s PNG size, %s: %d bytes of deflate against zlib -6's %d on the same %d bytes of filtered rows: %.3f times (at most 1.3)"
+              % ("PASS" if ours <= 1.3 * zlib6 else "FAIL", args, ours, zlib6, rows, ours / zlib6))
+    if "flat" in args:
+        print("%s PNG of one colour, 320x240: %d bytes of deflate for %d bytes of rows (at most 1000; zlib -6: %d)"
+              % ("PASS" if ours <= 1000 else "FAIL", ours, rows, zlib6))
+    k += 1
+why = decoded("noise", read("noise.ppm"))
+ours, zlib6, rows = sizes(read("noise.png"))
+most = rows + 5 * (rows // 16384 + 1) + 6    # 5 bytes a stored block (one a block of 16384 symbols), zlib's 6
+print("%s PNG of random bytes: %s; %d bytes of deflate for %d bytes of rows, at most %d: stored (zlib -6: %d)"
+      % ("FAIL" if why or ours > most else "PASS", why or "decodes to them", ours, rows, most, zlib6))
+ours, zlib6, rows = sizes(read("big.png"))      # decoded, as zlib checks its Adler-32
+cpu = float(read("big.time") or "nan")
+print("%s PNG of 640x480 noisy pixels written in %.3f s of CPU (at most 1): %d bytes of deflate (zlib -6: %d)"
+      % ("PASS" if cpu <= 1 else "FAIL", cpu, ours, zlib6))
+EOF
