@@ -1,5 +1,5 @@
 /* image.c - the image files: PPM (binary P6 or plain P3), PNG (compressed
- * with a deflate of its own) and PFM, each written whole or not at
+ * with a deflate of its own), PFM and OpenEXR, each written whole or not at
  * all (image.h).
  *
  * A render can take hours, so the output is opened before it starts (a bad
@@ -49,15 +49,15 @@ void free_image(Image *img)
 }
 
 
-/* The format -o asks for, by its extension: .png is PNG, .pfm PFM (floats,
- * the radiance itself); anything else is
+/* The format -o asks for, by its extension: .png is PNG, .pfm PFM and .exr
+ * OpenEXR (floats, the radiance itself); anything else is
  * PPM (.ppm, stdout, a device, a name without an extension), except the
  * image formats this program cannot write, which are refused rather than
  * given a PPM under their name. */
 int output_format(const char *name)
 {
     static const char *const other[] = { "jpg", "jpeg", "gif", "bmp", "tif", "tiff",
-                                         "webp", "tga", "exr", "hdr" };
+                                         "webp", "tga", "hdr" };
     const char *dot = strrchr(name, '.');
     char ext[8];
     size_t i;
@@ -67,9 +67,18 @@ int output_format(const char *name)
     ext[i] = 0;
     if (!strcmp(ext, "png")) return FORMAT_PNG;
     if (!strcmp(ext, "pfm")) return FORMAT_PFM;
+    if (!strcmp(ext, "exr")) return FORMAT_EXR;
     for (i = 0; i < sizeof other / sizeof *other; i++)
         if (!strcmp(ext, other[i])) return FORMAT_OTHER;
     return FORMAT_PPM;
+}
+
+int float_format(int format) { return format == FORMAT_PFM || format == FORMAT_EXR; }
+
+const char *format_name(int format)
+{
+    static const char *const names[] = { "PPM", "PNG", "PFM", "OpenEXR" };
+    return format >= FORMAT_PPM && format < FORMAT_OTHER ? names[format] : "another format";
 }
 
 /* Deflate (RFC 1951) in a zlib stream (RFC 1950), written from the RFCs for
@@ -82,7 +91,7 @@ int output_format(const char *name)
  *   write_block       a block with its own codes, or stored if that is smaller
  * Nothing depends on the machine: no floating point, no threads, and every
  * tie is broken by a position or a symbol's number, so the bytes are the
- * same everywhere. */
+ * same everywhere.  The PNG writer and the EXR writer use it. */
 
 #define WINDOW 32768                      /* the farthest back a copy may be (3.2.5) */
 #define MIN_MATCH 3                       /* the shortest copy, */
@@ -822,6 +831,142 @@ static void write_pfm(FILE *f, const Image *img)
         }
 }
 
+/* OpenEXR, written from "OpenEXR File Layout" (openexr.com) and its
+ * "Standard Attributes": a single-part scan-line file, version 2, of the
+ * float radiance (as PFM has it) in channels B, G, R (their names in
+ * alphabetical order, as the format requires), each pixel a 32-bit FLOAT
+ * (HALF would clip above 65504 and keep 11 bits: a render's radiance is
+ * kept whole).  ZIP_COMPRESSION: 16 lines a chunk, zlib-compressed after
+ * the format's own predictor; a chunk that would not shrink is stored as it
+ * is, which a reader knows by its size.  Every number is little-endian. */
+#define EXR_LINES 16                      /* the scan lines of a ZIP_COMPRESSION chunk */
+
+static void put_le(unsigned char *p, unsigned long v, int bytes)
+{
+    int i;
+    for (i = 0; i < bytes; i++, v >>= 8) p[i] = (unsigned char)(v & 0xFF);
+}
+
+static void put_float(unsigned char *p, float x)
+{
+    uint32_t u;
+    memcpy(&u, &x, 4);
+    put_le(p, (unsigned long)u, 4);
+}
+
+/* An attribute: its name and type, each ending in a 0 byte; the size of
+ * its value; the value. */
+static void exr_attribute(Bytes *b, const char *name, const char *type, const unsigned char *value, int n)
+{
+    unsigned char size[4];
+    put_le(size, (unsigned long)n, 4);
+    bytes_put(b, name, strlen(name) + 1);
+    bytes_put(b, type, strlen(type) + 1);
+    bytes_put(b, size, 4);
+    bytes_put(b, value, (size_t)n);
+}
+
+/* The magic number, the version field and the header: the attributes every
+ * file must have (in alphabetical order, as the library writes them), then
+ * a 0 byte. */
+static void exr_header(Bytes *b, int w, int h)
+{
+    static const unsigned char start[8] = { 0x76, 0x2F, 0x31, 0x01,  /* 20000630 */
+                                            2, 0, 0, 0 };  /* version 2; no flags: single-part scan lines */
+    unsigned char channels[3 * 18 + 1] = { 0 }, box[16], zip = 3, increasing_y = 0, one[4], centre[8];
+    int c;
+    for (c = 0; c < 3; c++) {             /* a name, then pixel type 2 (FLOAT), pLinear and */
+        unsigned char *ch = channels + 18 * c;  /* 3 bytes reserved 0, x and y sampling 1 */
+        ch[0] = (unsigned char)"BGR"[c];
+        put_le(ch + 2, 2, 4);
+        put_le(ch + 10, 1, 4);
+        put_le(ch + 14, 1, 4);
+    }
+    put_le(box, 0, 4);                    /* xMin, yMin, xMax, yMax: y grows downwards */
+    put_le(box + 4, 0, 4);
+    put_le(box + 8, (unsigned long)w - 1, 4);
+    put_le(box + 12, (unsigned long)h - 1, 4);
+    put_float(one, 1);
+    put_float(centre, 0);
+    put_float(centre + 4, 0);
+    bytes_put(b, start, 8);
+    exr_attribute(b, "channels", "chlist", channels, sizeof channels);
+    exr_attribute(b, "compression", "compression", &zip, 1);      /* 3: ZIP_COMPRESSION */
+    exr_attribute(b, "dataWindow", "box2i", box, 16);
+    exr_attribute(b, "displayWindow", "box2i", box, 16);
+    exr_attribute(b, "lineOrder", "lineOrder", &increasing_y, 1); /* 0: INCREASING_Y */
+    exr_attribute(b, "pixelAspectRatio", "float", one, 4);
+    exr_attribute(b, "screenWindowCenter", "v2f", centre, 8);
+    exr_attribute(b, "screenWindowWidth", "float", one, 4);
+    bytes_put(b, "", 1);                  /* the end of the header */
+}
+
+/* Lines y .. y + n - 1 as a chunk holds them: line by line, in each line
+ * the channels one after another (B, G, R), a float a pixel. */
+static void exr_lines(const Image *img, int y, int n, unsigned char *out)
+{
+    int j, c, i;
+    for (j = y; j < y + n; j++)
+        for (c = 2; c >= 0; c--)
+            for (i = 0; i < img->w; i++, out += 4) put_float(out, img->floats[3 * ((size_t)j * img->w + i) + c]);
+}
+
+/* ZIP_COMPRESSION's predictor, before zlib: the bytes at even places, then
+ * those at odd places (a float's like bytes together), then each byte as
+ * its difference from the one before, plus 128, modulo 256. */
+static void exr_predict(const unsigned char *in, size_t n, unsigned char *out)
+{
+    size_t i, half = (n + 1) / 2;
+    for (i = 0; i < n; i++) out[i % 2 ? half + i / 2 : i / 2] = in[i];
+    for (i = n - 1; i > 0; i--) out[i] = (unsigned char)(out[i] - out[i - 1] + 128);
+}
+
+/* The file: the header, the offset table (where each chunk starts in the
+ * file, 8 bytes each), then the chunks, made in memory first so that the
+ * table can come before them.  A chunk: its first line's y, its data's
+ * size, its data.  0: out of memory. */
+static int write_exr(FILE *f, const Image *img)
+{
+    int chunks = (img->h + EXR_LINES - 1) / EXR_LINES, c;
+    size_t most = (size_t)img->w * EXR_LINES * 12, *at = malloc(chunks * sizeof *at);
+    unsigned char *lines = malloc(most), *predicted = malloc(most), offset[8];
+    Bytes head = { NULL, 0, 0, 0 }, data = { NULL, 0, 0, 0 }, zip = { NULL, 0, 0, 0 };
+    int ok = at && lines && predicted;
+    exr_header(&head, img->w, img->h);
+    for (c = 0; ok && c < chunks; c++) {
+        int y = c * EXR_LINES, n = img->h - y < EXR_LINES ? img->h - y : EXR_LINES;
+        size_t size = (size_t)img->w * n * 12;
+        unsigned char numbers[8];
+        exr_lines(img, y, n, lines);
+        exr_predict(lines, size, predicted);
+        zip.n = 0;
+        ok = zlib_compress(predicted, size, &zip);
+        at[c] = data.n;
+        put_le(numbers, (unsigned long)y, 4);
+        put_le(numbers + 4, (unsigned long)(zip.n < size ? zip.n : size), 4);
+        bytes_put(&data, numbers, 8);
+        bytes_put(&data, zip.n < size ? zip.p : lines, zip.n < size ? zip.n : size);
+    }
+    ok = ok && !head.failed && !data.failed;
+    if (ok) {
+        fwrite(head.p, 1, head.n, f);
+        for (c = 0; c < chunks; c++) {
+            unsigned long long where = (unsigned long long)head.n + 8ull * chunks + at[c];
+            put_le(offset, (unsigned long)(where & 0xFFFFFFFFu), 4);
+            put_le(offset + 4, (unsigned long)(where >> 32), 4);
+            fwrite(offset, 1, 8, f);
+        }
+        fwrite(data.p, 1, data.n, f);
+    }
+    free(at);
+    free(lines);
+    free(predicted);
+    free(head.p);
+    free(data.p);
+    free(zip.p);
+    return ok;
+}
+
 /* rename() over an existing file: POSIX replaces it in one step; Windows
  * refuses, so there the old file is removed first (for a moment there is
  * neither: the best plain C can do). */
@@ -841,8 +986,9 @@ int write_image(Output *o, const Image *img, int plain)
     int ok = 1;
     errno = 0;
     if (o->format == FORMAT_PFM) write_pfm(o->f, img);
-    else if (o->format == FORMAT_PNG) {
-        ok = write_png(o->f, img->bytes, img->w, img->h, img->srgb);
+    else if (o->format == FORMAT_PNG || o->format == FORMAT_EXR) {
+        ok = o->format == FORMAT_PNG ? write_png(o->f, img->bytes, img->w, img->h, img->srgb)
+                                     : write_exr(o->f, img);
         if (!ok) errno = ENOMEM;
     } else
         write_ppm(o->f, img->bytes, img->w, img->h, plain);

@@ -1,8 +1,8 @@
 # Images people can open and keep (issue 22, section 4): PNG compressed by
-# image.c's own deflate.  Every check prints PASS, FAIL or SKIP
-# (tests/lib.sh).  The images are made first and then checked by one python
-# process (tests/png2ppm.py's decode()): a python
-# start costs a tenth of a second here.
+# image.c's own deflate, and OpenEXR.  Every check prints PASS, FAIL or SKIP
+# (tests/lib.sh).  The images are made first, then checked by one python
+# process for each format (the decode() of tests/png2ppm.py and of
+# tests/exr2pfm.py): a python start costs a tenth of a second here.
 . tests/lib.sh
 
 # tools/ppm2png: a PPM through the same PNG writer (image.c).
@@ -85,4 +85,87 @@ ours, zlib6, rows = sizes(read("big.png"))      # decoded, as zlib checks its Ad
 cpu = float(read("big.time") or "nan")
 print("%s PNG of 640x480 noisy pixels written in %.3f s of CPU (at most 1): %d bytes of deflate (zlib -6: %d)"
       % ("PASS" if cpu <= 1 else "FAIL", cpu, ours, zlib6))
+EOF
+
+# --- OpenEXR.  Renders as EXR and PFM: heights that are not multiples of 16
+# (a chunk's lines), and noise that leaves some chunks as they are (not
+# smaller zipped).
+k=0
+for args in "-s 1x1 scenes/whitted.sph" "-s 4000x1 scenes/whitted.sph" "-s 33x17 scenes/minray.sph" \
+            "-s 160x120 scenes/demo.nff" "-s 120x90 -n 4 --pt scenes/cornell.sph" "-s 64x48 -n 2 scenes/smallpt.sph"; do
+  k=$((k + 1))
+  ./ray $args -o "$TMP/exr$k.pfm" 2> /dev/null && ./ray $args -o "$TMP/exr$k.exr" 2> /dev/null
+  echo "$args" > "$TMP/exr$k.args"
+done
+./ray -s 9x4 -o "$TMP/X.EXR" scenes/whitted.sph
+[ "$(head -c 4 "$TMP/X.EXR" | od -An -tx1 | tr -d ' ')" = 762f3101 ] \
+  && ok "-o X.EXR (upper case) writes OpenEXR" || bad "-o X.EXR"
+./ray -s 4x4 --p3 -o "$TMP/p.exr" scenes/whitted.sph 2> "$TMP/err"; rc=$?
+[ $rc = 2 ] && [ ! -e "$TMP/p.exr" ] && ok "--p3 -o x.exr refused, exit 2: $(sed "s|$TMP/||" "$TMP/err")" \
+  || bad "--p3 -o x.exr: exit $rc"
+
+# Where Debian's OpenEXR tools are (package openexr; .ci/run installs it):
+# exrheader reads the header as ray wrote it, and the library itself decodes
+# the pixels (exrmaketiled writes them again as one uncompressed tile, which
+# exr2pfm.decode(tiled=True) reads below).  exr5 is the Cornell box, 120x90.
+if command -v exrheader > /dev/null; then
+  exrheader "$TMP/exr5.exr" > "$TMP/head" 2>&1 && [ "$(grep -c "32-bit floating-point, sampling 1 1" "$TMP/head")" = 3 ] \
+    && grep -q "zip, multi-scanline blocks" "$TMP/head" && grep -q "dataWindow (type box2i): (0 0) - (119 89)" "$TMP/head" \
+    && ok "exrheader reads ray's EXR: B, G, R floats, zip, 120x90" || bad "exrheader: $(head -5 "$TMP/head")"
+else
+  skip "exrheader reads ray's EXR: exrheader is not installed (Debian's openexr)"
+fi
+if command -v exrmaketiled > /dev/null; then
+  exrmaketiled -t 120 90 -z none "$TMP/exr5.exr" "$TMP/tiled.exr" > "$TMP/err" 2>&1 \
+    || bad "exrmaketiled reads ray's EXR: $(cat "$TMP/err")"
+else
+  skip "the OpenEXR library decodes ray's EXR: exrmaketiled is not installed (Debian's openexr)"
+fi
+
+# Each EXR read by exr2pfm.decode() (written from the file layout document:
+# magic, version, each required attribute, the offset table, each chunk's y
+# and size, zlib and the predictor undone) into a PFM that must be ./ray's
+# PFM of the same render, byte for byte.  The reader is strict: one byte
+# changed in a chunk's zlib stream, in the offset table, the channels' type,
+# or a byte after the last chunk, and it refuses.
+python3 - "$TMP" <<'EOF'
+import os, struct, sys
+sys.path.insert(0, "tests")
+import exr2pfm
+tmp = sys.argv[1]
+def read(name): return open(os.path.join(tmp, name), "rb").read()
+def decoded(data, want, tiled=False):
+    try:
+        pfm, kinds = exr2pfm.decode(data, tiled)
+    except SystemExit as e:
+        return str(e), []
+    return "" if pfm == want else "decodes to other floats", kinds
+k, every = 1, []
+while os.path.exists(os.path.join(tmp, "exr%d.args" % k)):
+    name, args = "exr%d" % k, read("exr%d.args" % k).decode().strip()
+    why, kinds = decoded(read(name + ".exr"), read(name + ".pfm"))
+    every += kinds
+    print("%s EXR %s: %s" % ("FAIL" if why else "PASS", args, why or "decodes to the PFM's bytes (%d bytes, the PFM %d)"
+                             % (len(read(name + ".exr")), len(read(name + ".pfm")))))
+    k += 1
+print("%s EXR chunks both zipped (%d) and stored as they are (%d)"
+      % ("PASS" if "zip" in every and "stored" in every else "FAIL", every.count("zip"), every.count("stored")))
+if os.path.exists(os.path.join(tmp, "tiled.exr")):
+    why, _ = decoded(read("tiled.exr"), read("exr5.pfm"), tiled=True)
+    print("%s the OpenEXR library decodes ray's ZIP chunks to the PFM's floats (exrmaketiled): %s"
+          % ("FAIL" if why else "PASS", why or "the same bytes"))
+good = read("exr3.exr")        # minray 33x17: two chunks, both zipped
+table = good.index(b"screenWindowWidth\0float\0") + len("screenWindowWidth\0float\0") + 4 + 4 + 1
+first, = struct.unpack("<Q", good[table:table + 8])
+def changed(at, xor=0x55, extra=b""):
+    data = bytearray(good) + extra
+    if at is not None:
+        data[at] ^= xor
+    return bytes(data)
+for what, data in (("a byte of chunk 0's zlib stream", changed(first + 8 + 20)),
+                   ("the offset table", changed(table, 1)),
+                   ("the channels' type (B as HALF)", changed(good.index(b"chlist\0") + 7 + 4 + 2, 3)),
+                   ("a byte after the last chunk", changed(None, extra=b"\0"))):
+    why, _ = decoded(data, b"")
+    print("%s exr2pfm refuses a file with %s changed: %s" % ("PASS" if why.startswith("exr2pfm") else "FAIL", what, why))
 EOF

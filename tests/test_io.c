@@ -111,6 +111,7 @@ static void test_extensions(void)
 {
     check(output_format("a.png") == FORMAT_PNG && output_format("A.PnG") == FORMAT_PNG
               && output_format("x.ppm") == FORMAT_PPM && output_format("png") == FORMAT_PPM
+              && output_format("x.exr") == FORMAT_EXR && output_format("X.EXR") == FORMAT_EXR
               && output_format("/dev/null") == FORMAT_PPM && output_format("a.JPG") == FORMAT_OTHER,
           "formats by extension, in any case");
     check(has_extension("DEMO.NFF", ".nff") && has_extension("d.nff", ".nff")
