@@ -41,28 +41,56 @@ TIMEFORMAT=%U
 # against zlib's: python's zlib at level 6 (its default) on the very rows
 # the PNG holds (inflated from its IDAT chunks: the same filter byte chosen
 # for each row), against the PNG's IDAT bytes: within 1.3 times on
-# realistic renders (Whitted's scene at 320x240, a path-traced Cornell box).
+# realistic renders (Whitted's scene at 320x240, a path-traced Cornell box);
+# the checks hold it to 1.1 (it is within 1% today), a guard against a
+# search made worse.  The filters: each row's the heuristic's, recomputed
+# from the pixels (the Cornell box), and sub, up, average and Paeth all
+# chosen.
 python3 - "$TMP" <<'EOF'
 import os, struct, sys, zlib
 sys.path.insert(0, "tests")
 import png2ppm
 tmp = sys.argv[1]
 def read(name): return open(os.path.join(tmp, name), "rb").read()
-def sizes(png):
+def inflated(png):
+    """The IDAT bytes, and the rows they inflate to."""
     pos, idat = 8, b""
     while pos < len(png):
         n, kind = struct.unpack(">I4s", png[pos:pos + 8])
         idat += png[pos + 8:pos + 8 + n] if kind == b"IDAT" else b""
         pos += 12 + n
-    rows = zlib.decompress(idat)
+    return idat, zlib.decompress(idat)
+def sizes(png):
+    idat, rows = inflated(png)
     return len(idat), len(zlib.compress(rows, 6)), len(rows)
+def heuristic(ppm):
+    """Each row's filter type as ISO/IEC 15948 12.8 recommends, from the
+    pixels: the least sum of the filtered bytes' absolute values, taken as
+    signed (ties: the lower type)."""
+    head = ppm.split(b"\n", 3)
+    w, h = map(int, head[1].split())
+    px, n, up, types = head[3], 3 * w, bytes(3 * w), []
+    for j in range(h):
+        row, sums = px[j * n:(j + 1) * n], []
+        for t in range(5):
+            total = 0
+            for i in range(n):
+                a, b, c = row[i - 3] if i >= 3 else 0, up[i], up[i - 3] if i >= 3 else 0
+                p = a + b - c
+                paeth = a if abs(p - a) <= abs(p - b) and abs(p - a) <= abs(p - c) else b if abs(p - b) <= abs(p - c) else c
+                d = (row[i] - (0, a, b, (a + b) // 2, paeth)[t]) & 255
+                total += min(d, 256 - d)
+            sums.append(total)
+        types.append(sums.index(min(sums)))
+        up = row
+    return types
 def decoded(name, want):
     try:
         ppm, _ = png2ppm.decode(read(name + ".png"))
     except SystemExit as e:
         return str(e)
     return "" if ppm == want else "decodes to other pixels"
-k = 1
+k, chosen = 1, set()
 while os.path.exists(os.path.join(tmp, "png%d.args" % k)):
     name, args = "png%d" % k, read("png%d.args" % k).decode().strip()
     why = decoded(name, read(name + ".ppm"))
@@ -70,12 +98,22 @@ while os.path.exists(os.path.join(tmp, "png%d.args" % k)):
                              % (len(read(name + ".png")), len(read(name + ".ppm")))))
     ours, zlib6, rows = sizes(read(name + ".png"))
     if "--gamma" in args or "cornell" in args:
-        print("%s PNG size, %s: %d bytes of deflate against zlib -6's %d on the same %d bytes of filtered rows: %.3f times (at most 1.3)"
-              % ("PASS" if ours <= 1.3 * zlib6 else "FAIL", args, ours, zlib6, rows, ours / zlib6))
+        print("%s PNG size, %s: %d bytes of deflate against zlib -6's %d on the same %d bytes of filtered rows: %.3f times (at most 1.1, a guard; the issue asks 1.3)"
+              % ("PASS" if ours <= 1.1 * zlib6 else "FAIL", args, ours, zlib6, rows, ours / zlib6))
+        w = struct.unpack(">I", read(name + ".png")[16:20])[0]
+        types = list(inflated(read(name + ".png"))[1][::3 * w + 1])
+        chosen |= set(types)
+    if "cornell" in args:
+        want = heuristic(read(name + ".ppm"))
+        print("%s PNG filters, %s: each row's the one the heuristic of ISO/IEC 15948 12.8 chooses%s"
+              % ("PASS" if types == want else "FAIL", args, "" if types == want else
+                 ": not in rows %s" % [j for j in range(len(want)) if types[j] != want[j]][:10]))
     if "flat" in args:
         print("%s PNG of one colour, 320x240: %d bytes of deflate for %d bytes of rows (at most 1000; zlib -6: %d)"
               % ("PASS" if ours <= 1000 else "FAIL", ours, rows, zlib6))
     k += 1
+print("%s PNG filters: sub, up, average and Paeth are each chosen for some row in these two renders (chose %s)"
+      % ("PASS" if {1, 2, 3, 4} <= chosen else "FAIL", sorted(chosen)))
 why = decoded("noise", read("noise.ppm"))
 ours, zlib6, rows = sizes(read("noise.png"))
 most = rows + 5 * (rows // 16384 + 1) + 6    # 5 bytes a stored block (one a block of 16384 symbols), zlib's 6
