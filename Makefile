@@ -7,7 +7,7 @@
 # make fuzz     libFuzzer on the scene readers (clang; fuzz/): builds build/fuzz/fuzz_sph,
 #               fuzz_nff and fuzz_obj and runs each FUZZ_SECONDS (60; FUZZ_SECONDS=600 for longer;
 #               FUZZ_SEED=N for libFuzzer's -seed)
-# make clean    the programs, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm)
+# make clean    the programs, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm, *.exr)
 CC     ?= cc
 CFLAGS ?= -O2
 LDLIBS  = -lm
@@ -94,7 +94,7 @@ bench: all spd
 
 clean:
 	rm -rf $(PROGS) build bench/out scenes/spd
-	rm -f *.ppm *.png *.pfm
+	rm -f *.ppm *.png *.pfm *.exr
 
 FORCE:
 
