@@ -10,7 +10,7 @@
 #               FUZZ_SEED=N for libFuzzer's -seed)
 # make install  ./ray and its manual page ray.1 into $(DESTDIR)$(PREFIX)/bin and
 #               $(DESTDIR)$(PREFIX)/share/man/man1 (PREFIX=/usr/local); make uninstall removes them
-# make clean    the programs, ray.1, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm)
+# make clean    the programs, ray.1, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm, *.exr)
 CC     ?= cc
 CFLAGS ?= -O2
 LDLIBS  = -lm
@@ -126,7 +126,7 @@ bench: all spd
 
 clean:
 	rm -rf $(PROGS) ray.1 build bench/out scenes/spd
-	rm -f *.ppm *.png *.pfm
+	rm -f *.ppm *.png *.pfm *.exr
 
 FORCE:
 

@@ -26,8 +26,9 @@ void usage(FILE *to)
           "format (README.md), or NFF (Eric Haines' Neutral File Format, the SPD\n"
           "scenes') when it ends .nff; an OBJ mesh alone, framed and lit, when it\n"
           "ends .obj; - reads the sphere format or NFF from standard input.\n"
-          "  -o FILE    output image: PNG if FILE ends .png, PFM (floats) if .pfm, else\n"
-          "             PPM (default: SCENE's base name + .ppm; - for stdout)\n"
+          "  -o FILE    output image: PNG if FILE ends .png, PFM or OpenEXR (floats) if\n"
+          "             .pfm or .exr, else PPM (default: SCENE's base name + .ppm; - for\n"
+          "             stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
           "  -n N       samples per pixel (default: the scene's `samples`, else 1)\n"
           "  -d N       Whitted: recursion depth, 1 = primary rays only (default: the\n"
@@ -43,7 +44,7 @@ void usage(FILE *to)
           "             noise\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
           "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
-          "             card's; a path-traced image always has it, but for PFM)\n"
+          "             card's; a path-traced image always has it, but for PFM and EXR)\n"
           "  --accel A  kd (the kd-tree), bvh (bounding volume hierarchy), grid\n"
           "             (uniform grid), none (test every object) or auto (default:\n"
           "             the scene's `accel` line, else from 8 objects up the one that\n"
@@ -162,11 +163,10 @@ static int output_usable(const char *name, int plain)
 {
     int format = strcmp(name, "-") ? output_format(name) : FORMAT_PPM;
     if (format == FORMAT_OTHER)
-        fprintf(stderr, "ray: cannot write %s: the formats are PPM, PNG and PFM (-o x.ppm, x.png, x.pfm)\n",
-                name);
+        fprintf(stderr, "ray: cannot write %s: the formats are PPM, PNG, PFM and OpenEXR "
+                "(-o x.ppm, x.png, x.pfm, x.exr)\n", name);
     else if (format != FORMAT_PPM && plain)
-        fprintf(stderr, "ray: --p3 is a PPM form; %s is a %s\n", name,
-                format == FORMAT_PNG ? "PNG" : "PFM");
+        fprintf(stderr, "ray: --p3 is a PPM form; %s is %s, not PPM\n", name, format_name(format));
     return format == FORMAT_PPM || (format != FORMAT_OTHER && !plain);
 }
 

@@ -371,7 +371,7 @@ typedef struct Hooks {
 } Hooks;
 
 /* The image being made (image.h): bytes (for PPM and PNG), or floats (for
- * PFM), row by row from the top-left, three channels a pixel. */
+ * PFM and EXR), row by row from the top-left, three channels a pixel. */
 
 /* ----------------------------------------------------------------- vectors */
 
@@ -589,7 +589,7 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
     return scale((real)1 / spp, sum);
 }
 
-/* The pixel into the image: as floats (for PFM, the radiance itself), or
+/* The pixel into the image: as floats (for PFM and EXR, the radiance itself), or
  * as bytes, through the sRGB curve where the image asks for it. */
 static void put_pixel(Image *img, int i, int j, vec c)
 {
@@ -3429,7 +3429,7 @@ int main(int argc, char **argv)
 
     s.set.view = a.view;
     if (a.view == VIEW_DEPTH) s.set.far = farthest(&s);
-    if (!new_image(&img, s.set.w, s.set.h, out.format == FORMAT_PFM, !a.view && (s.set.integrator == PATH || a.gamma))) {
+    if (!new_image(&img, s.set.w, s.set.h, float_format(out.format), !a.view && (s.set.integrator == PATH || a.gamma))) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.set.w, s.set.h);
         discard_output(&out);
         free_scene(&s); free(a.made);

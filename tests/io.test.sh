@@ -5,8 +5,9 @@
 
 # --- PNG: decoded by tests/png2ppm.py (python's zlib inflates it, every CRC
 # and the Adler-32 are checked) and compared byte for byte with the PPM of the
-# same render: width 1, odd sizes, exactly one and two full stored blocks
-# (28x771: 85 x 771 = 65535 bytes of rows), and more than one block.
+# same render: width 1, odd sizes, 65535 and 131070 bytes of rows (28x771,
+# 28x1542: once a stored block's most), and more than one IDAT chunk.
+# tests/image.test.sh has the rest: sizes, noise, and the size against zlib.
 for size in 1x1 1x9 7x5 33x17 28x771 28x1542 160x140; do
   ./ray -s $size -o "$TMP/p.ppm" scenes/minray.sph && ./ray -s $size -o "$TMP/p.png" scenes/minray.sph \
     && python3 tests/png2ppm.py "$TMP/p.png" > "$TMP/back.ppm" 2> "$TMP/err" && cmp -s "$TMP/back.ppm" "$TMP/p.ppm" \

@@ -5,8 +5,8 @@ It checks what a PNG must be (signature; IHDR first; every chunk's CRC-32;
 IDAT chunks in one run; the zlib stream whole, its Adler-32 right and nothing
 after it; IEND last and empty) and prints the image as a binary PPM (P6), so
 that a test can compare it byte for byte with ray.c's own PPM.  With -c it
-also prints the names of the chunks, one a line, on stderr.
-Only the test suite uses it; ray.c never does."""
+also prints the names of the chunks, one a line, on stderr.  A test may
+import it and call decode().  Only the test suite uses it; ray.c never does."""
 import struct
 import sys
 import zlib
@@ -53,17 +53,17 @@ def unfilter(raw, width, height):
     return bytes(out)
 
 
-def main():
-    args = [a for a in sys.argv[1:] if a != "-c"]
-    data = open(args[0], "rb").read()
+def decode(data):
+    """The PNG in data as a binary PPM, and the names of its chunks; a
+    SystemExit with the reason if it is not the PNG it must be."""
     if data[:8] != b"\x89PNG\r\n\x1a\n":
         fail("not a PNG signature")
     seen = list(chunks(data))
     names = [k.decode("latin-1") for k, _ in seen]
-    if "-c" in sys.argv:
-        sys.stderr.write("".join(n + "\n" for n in names))
     if not names or names[0] != "IHDR" or names[-1] != "IEND" or seen[-1][1]:
         fail("IHDR must come first and an empty IEND last: %s" % names)
+    if "IDAT" not in names:
+        fail("no IDAT chunk: %s" % names)
     first, last = names.index("IDAT"), len(names) - 1 - names[::-1].index("IDAT")
     if names[first:last + 1] != ["IDAT"] * (last - first + 1):
         fail("IDAT chunks are not consecutive: %s" % names)
@@ -79,7 +79,16 @@ def main():
         fail("the zlib stream is incomplete or has bytes after its end")
     if len(raw) != height * (3 * width + 1):
         fail("%d bytes of rows, not %d" % (len(raw), height * (3 * width + 1)))
-    sys.stdout.buffer.write(b"P6\n%d %d\n255\n" % (width, height) + unfilter(raw, width, height))
+    return b"P6\n%d %d\n255\n" % (width, height) + unfilter(raw, width, height), names
 
 
-main()
+def main():
+    args = [a for a in sys.argv[1:] if a != "-c"]
+    ppm, names = decode(open(args[0], "rb").read())
+    if "-c" in sys.argv:
+        sys.stderr.write("".join(n + "\n" for n in names))
+    sys.stdout.buffer.write(ppm)
+
+
+if __name__ == "__main__":
+    main()
