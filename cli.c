@@ -42,6 +42,9 @@ void usage(FILE *to)
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
           "  --seed N   the path tracer's noise, 0 or more (default 0): another N, other\n"
           "             noise\n"
+          "  --adaptive E  samples in doubling rounds (Whitted's from 8, the path\n"
+          "             tracer's from 16) up to -n: a pixel stops once its byte is known\n"
+          "             to within E steps with 95% confidence, by its own samples\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
           "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
           "             card's; a path-traced image always has it, but for PFM and EXR)\n"
@@ -51,7 +54,8 @@ void usage(FILE *to)
           "             renders a 32x32 probe of the image fastest, its build included)\n"
           "  --view V   instead of the picture, what a ray through each pixel's centre\n"
           "             meets: steps (the structure's work: nodes or cells plus tests,\n"
-          "             black 0, blue 25, red 50, yellow 100, white 200), normal, depth\n"
+          "             black 0, blue 25, red 50, yellow 100, white 200), normal, depth;\n"
+          "             or samples: the samples each pixel took, white for all of -n\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr;\n"
           "             --stats=kv: the same as one `key value` line each\n"
           "  --version  the version, and how it was built\n"
@@ -105,11 +109,25 @@ static int view_arg(const char *v)
 {
     if (!strcmp(v, "steps")) return 1;
     if (!strcmp(v, "normal")) return 2;
+    if (!strcmp(v, "samples")) return 4;
     if (strcmp(v, "depth")) {
-        fprintf(stderr, "ray: --view takes steps, normal or depth, not %s\n", v);
+        fprintf(stderr, "ray: --view takes steps, normal, depth or samples, not %s\n", v);
         exit(2);
     }
     return 3;
+}
+
+/* A number of 8-bit steps, above 0 and at most 255, or exit with a message. */
+static double steps_arg(const char *opt, const char *arg)
+{
+    char *end;
+    double v = arg ? strtod(arg, &end) : 0;
+    if (!arg || end == arg || *end || !(v > 0 && v <= 255)) {
+        fprintf(stderr, "ray: %s takes a number of 8-bit steps above 0, at most 255, not %s\n", opt,
+                arg ? arg : "nothing");
+        exit(2);
+    }
+    return v;
 }
 
 /* The path tracer's estimator named by --estimator, or exit with the choices. */
@@ -228,6 +246,7 @@ int parse_args(int argc, char **argv, Args *a)
         else if (!strcmp(o, "--no-roulette")) a->roulette = 0;
         else if ((v = option_value(argc, argv, &i, "--seed"))) a->seed = int_arg("--seed", v, 0, 2147483647);
         else if ((v = option_value(argc, argv, &i, "--estimator"))) a->estimator = estimator_arg(v);
+        else if ((v = option_value(argc, argv, &i, "--adaptive"))) a->adaptive = steps_arg("--adaptive", v);
         else if (o[0] == '-' && o[1]) {
             fprintf(stderr, "ray: unknown option: %s\n", o);
             usage(stderr);
@@ -286,6 +305,9 @@ static void print_stats_kv(FILE *f, const Stats *st)
             "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
             all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced,
             st->cut, st->discarded);
+    if (st->adaptive > 0)
+        fprintf(f, "adaptive_steps %g\nsamples_per_pixel %.4f\nsamples_min %d\nsamples_max %d\n",
+                st->adaptive, (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max);
     fprintf(f, "queries %llu\nnearest_queries %llu\nhits %llu\ntests %llu\nsteps %llu\n",
             st->queries, st->nearest, st->hits, st->tests, st->steps);
     fprintf(f, "load_s %.6f\nbuild_s %.6f\nrender_s %.6f\ncpu_s %.6f\n", st->load, st->build,
@@ -350,6 +372,9 @@ void print_stats(FILE *f, const Stats *st, int kv)
     if (!st->path && st->cut)
         fprintf(f, "budget     %llu reflected or refracted rays not traced: past %d a primary ray\n",
                 st->cut, st->budget);
+    if (st->adaptive > 0)
+        fprintf(f, "adaptive   to %g steps: %.2f samples a pixel, from %d to %d (of %d)\n", st->adaptive,
+                (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max, st->spp);
     fprintf(f, "hits       %llu (%.1f%% of the rays that ask for the nearest hit)\n", st->hits,
             st->nearest ? 100.0 * st->hits / (double)st->nearest : 0.0);
     fprintf(f, "per ray    %.2f intersection tests, %.2f tree steps\n",

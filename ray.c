@@ -238,7 +238,9 @@ typedef struct {
     int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
     int roulette;             /* 1: Russian roulette ends paths */
     unsigned seed;            /* --seed: which noise */
-    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, or 0 */
+    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, or 0 */
+    real adaptive;            /* --adaptive E: a pixel stops when its byte is known to E steps (0: off) */
+    int srgb;                 /* the bytes go through the sRGB curve (for adaptive's rule) */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
     const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
 } Settings;
@@ -296,7 +298,7 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
  * tracer's three estimators of the light at a point: by sampling the BSDF
  * only, by next-event estimation, or by both weighed by MIS. */
 enum { WHITTED, PATH };
-enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH };
+enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
 enum { BSDF_ONLY, NEE, MIS };
 
 /* Objects are numbered spheres first, then cones, then triangles. */
@@ -337,6 +339,8 @@ typedef struct {
     unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
     unsigned long long bounced, discarded;      /* path tracer: BSDF-sampled rays; bad samples */
     unsigned long long cut;                     /* Whitted: rays past a primary ray's budget */
+    unsigned long long samples;                 /* samples the pixels took, all together; */
+    int spp_min, spp_max;                       /* the fewest and most one pixel took (0: none yet) */
     int threads;                                /* how many threads rendered */
 } Counts;
 
@@ -356,6 +360,7 @@ typedef struct {
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
     const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
     long long *splat;           /* this thread's splat image (see splat()), or NULL */
+    int taken;                  /* samples the last pixel took (--view samples) */
 } Worker;
 
 /* Two hooks in render() for the integrators still to come.  prepass runs
@@ -424,6 +429,12 @@ static void box_union(double lo[3], double hi[3], const double lo2[3], const dou
 /* for each pixel */
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
+typedef struct { vec sum, sq; int n; } Tally;
+static void tally(Tally *t, vec c);
+static int pixel_done(const Scene *s, const Tally *t, int first);
+static int settled(const Scene *s, const Tally *t);
+static real srgb_slope(real v);
+static vec pixel_mean(const Tally *t, Worker *wk);
 static void put_pixel(Image *img, int i, int j, vec c);
 static real srgb(real v);
 static unsigned char to_byte(real v);
@@ -562,19 +573,23 @@ static real triangle_pdf(const Triangle *tr, real dist, real cosy);
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 {
     int i;
-    for (i = 0; i < s->set.w; i++)
-        put_pixel(img, i, j, s->set.view ? pixel_view(s, i, j, wk)      /* --view: see the plumbing */
-                             : s->set.integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
-                             : pixel_color(s, i, j, spp, wk));
+    for (i = 0; i < s->set.w; i++) {
+        vec c = s->set.view && s->set.view != VIEW_SAMPLES ? pixel_view(s, i, j, wk)  /* --view: the plumbing */
+                : s->set.integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
+                : pixel_color(s, i, j, spp, wk);
+        if (s->set.view == VIEW_SAMPLES) c = scale((real)wk->taken / spp, v3(1, 1, 1));
+        put_pixel(img, i, j, c);
+    }
 }
 
-/* The pixel's colour: RayTrace of each of its spp samples, averaged. */
+/* The pixel's colour: RayTrace of each of its spp samples, averaged (with
+ * --adaptive, of those it takes: from 8 on, see pixel_done). */
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
 {
-    vec sum = v3(0, 0, 0);
+    Tally t = { { 0, 0, 0 }, { 0, 0, 0 }, 0 };
     real shift = s->moving ? time_shift(wk, s, i, j) : 0;   /* no motion: no numbers drawn */
     int k;
-    for (k = 0; k < spp; k++) {
+    for (k = 0; k < spp && !pixel_done(s, &t, 8); k++) {
         real dx, dy;
         Ray r;
         sample_offset(k, s->cam.anchor, &dx, &dy);
@@ -583,10 +598,78 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
         wk->budget = RAY_BUDGET;
         r = primary_ray(s, i + dx, j + dy, wk);
         if (s->moving) r.time = shutter_time(s, k, shift);
-        sum = add(sum, trace(s, r, s->set.depth, 1, wk));
+        tally(&t, trace(s, r, s->set.depth, 1, wk));
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
-    return scale((real)1 / spp, sum);
+    return pixel_mean(&t, wk);
+}
+
+/* Adaptive sampling (--adaptive E).  A pixel's samples come in rounds
+ * that double (Whitted's from 8, the path tracer's from 16), and at the end
+ * of each the pixel stops if its byte is known to within E steps of 255
+ * with 95% confidence: for each channel, the half-width 1.96 s / sqrt(n)
+ * of the confidence interval of its mean (s the standard deviation of its
+ * n samples: the central limit theorem), times the slope of the curve from
+ * colour to byte there, is at most E / 255.  A channel whose whole
+ * interval lies at or above 1 is white whatever its error.  Only the
+ * pixel's own samples decide, so the bytes are the same for any thread
+ * count; and a pixel that takes all of -n gets the bytes it gets without
+ * --adaptive.  What it misses: a path too rare to show in a round's
+ * samples (a caustic's speck lit through glass one path in hundreds)
+ * leaves s small, and the pixel may stop without it, darker than it should
+ * be; the path tracer's 16 samples at least, and decisions only at the
+ * ends of rounds, keep that to paths rarer than about one in 16 where the
+ * rest agree.  Whitted's samples are the R2 points, not random, yet
+ * spread evenly: where the first 8 agree (a flat wall, the sky) the
+ * pixel is done; an edge, a shadow's or a refracted edge, makes them
+ * disagree and the pixel goes on.  Not from 4: four points that agree
+ * miss an edge that cuts a corner of the pixel often enough that the
+ * image's error stops falling as -n grows. */
+static void tally(Tally *t, vec c)
+{
+    t->sum = add(t->sum, c);
+    t->sq = add(t->sq, mul(c, c));
+    t->n++;
+}
+
+/* Whether the pixel stops now, after t->n samples: only with --adaptive,
+ * only at a round's end (first, 2 first, 4 first, ...; first a power of
+ * two), and then if settled() says so. */
+static int pixel_done(const Scene *s, const Tally *t, int first)
+{
+    return s->set.adaptive > 0 && t->n >= first && (t->n & (t->n - 1)) == 0 && settled(s, t);
+}
+
+static int settled(const Scene *s, const Tally *t)
+{
+    double sum[3], sq[3];
+    int c;
+    to3(t->sum, sum);
+    to3(t->sq, sq);
+    for (c = 0; c < 3; c++) {
+        double mean = sum[c] / t->n, var = fmax(0, (sq[c] - sum[c] * mean) / (t->n - 1));
+        double half = 1.96 * sqrt(var / t->n), slope = s->set.srgb ? srgb_slope((real)fmax(0, mean - half)) : 1;
+        if (mean - half < 1 && slope * half > s->set.adaptive / 255) return 0;
+    }
+    return 1;
+}
+
+/* The slope of the sRGB curve (srgb() below) at v: the bytes per unit of
+ * light there, 12.92 in the straight part near black. */
+static real srgb_slope(real v)
+{
+    return v <= (real)0.0031308 ? (real)12.92 : (real)(1.055 / 2.4 * pow(v, 1 / 2.4 - 1));
+}
+
+/* The pixel's value, the mean of the samples it took, which are counted
+ * for --stats and --view samples. */
+static vec pixel_mean(const Tally *t, Worker *wk)
+{
+    wk->taken = t->n;
+    wk->count.samples += (unsigned)t->n;
+    if (!wk->count.spp_max || t->n < wk->count.spp_min) wk->count.spp_min = t->n;
+    if (t->n > wk->count.spp_max) wk->count.spp_max = t->n;
+    return scale((real)1 / t->n, t->sum);
 }
 
 /* The pixel into the image: as floats (for PFM and EXR, the radiance itself), or
@@ -1305,15 +1388,19 @@ enum { DIFFUSE_LOBE, GLOSSY_LOBE, MIRROR_LOBE, GGX_LOBE, GLASS_LOBE, LOBE_KINDS 
  * and left out, so that no NaN reaches an image. */
 static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk)
 {
-    vec sum = v3(0, 0, 0), L;
+    Tally t = { { 0, 0, 0 }, { 0, 0, 0 }, 0 };
+    vec L;
     int k;
-    for (k = 0; k < spp; k++) {
+    for (k = 0; k < spp && !pixel_done(s, &t, 16); k++) {     /* --adaptive: see pixel_done */
         L = sample_radiance(s, i, j, k, wk);
-        if (isfinite(L.x) && isfinite(L.y) && isfinite(L.z)) sum = add(sum, L);
-        else wk->count.discarded++;
+        if (!(isfinite(L.x) && isfinite(L.y) && isfinite(L.z))) {
+            wk->count.discarded++;
+            L = v3(0, 0, 0);
+        }
+        tally(&t, L);
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
-    return scale((real)1 / spp, sum);
+    return pixel_mean(&t, wk);
 }
 
 /* Sample k of pixel (i, j): the radiance along one camera ray through a
@@ -2837,6 +2924,9 @@ static void add_counts(Counts *to, const Counts *from)
     to->bounced += from->bounced;
     to->discarded += from->discarded;
     to->cut += from->cut;
+    to->samples += from->samples;
+    if (from->spp_max && (!to->spp_max || from->spp_min < to->spp_min)) to->spp_min = from->spp_min;
+    if (from->spp_max > to->spp_max) to->spp_max = from->spp_max;
     if (from->threads > to->threads) to->threads = from->threads;
 }
 
@@ -3286,6 +3376,7 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.refracted = c->refracted, st.bounced = c->bounced, st.cut = c->cut, st.budget = RAY_BUDGET;
     st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
     st.hits = c->hits, st.tests = c->tests, st.steps = c->steps;
+    st.adaptive = s->set.adaptive, st.samples = c->samples, st.spp_min = c->spp_min, st.spp_max = c->spp_max;
     st.load = load, st.build = build, st.seconds = seconds, st.cpu = cpu;
     print_stats(stderr, &st, kv);
 }
@@ -3428,6 +3519,8 @@ int main(int argc, char **argv)
     if (!ok || !open_output(&out, a.output)) { free_scene(&s); free(a.made); return 1; }
 
     s.set.view = a.view;
+    s.set.adaptive = (real)a.adaptive;
+    s.set.srgb = s.set.integrator == PATH || a.gamma;
     if (a.view == VIEW_DEPTH) s.set.far = farthest(&s);
     if (!new_image(&img, s.set.w, s.set.h, float_format(out.format), !a.view && (s.set.integrator == PATH || a.gamma))) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.set.w, s.set.h);
