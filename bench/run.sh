@@ -87,6 +87,9 @@
 #   dist    the distribution effects (a lens, an area light, glossy plates):
 #           each renderer's CPU time against its RMSE, the two taking turns
 #           (bench/dist.sh; plotted to dist.svg)
+#   adaptive Whitted's adaptive sampling at equal error: uniform 16 samples
+#           against --adaptive settings, RMSE and CPU time, taking turns
+#           (bench/adaptive.sh)
 # Embree and POV-Ray are instruments, not dependencies: when one is missing
 # its rows say "not installed, skipped".  BENCH_INSTALL=1 first tries
 # `apt-get install -y libembree-dev povray` for the missing ones.
@@ -100,7 +103,7 @@
 # Knobs (environment; with the defaults `make bench` takes about 9 minutes of
 # CPU on the 2-core development machine, 11 of wall clock beside other work;
 # 11 and 18 when it renders anew the references it keeps between runs):
-#   BENCH_PARTS="render spd build rays accel anim far pov pt dist"
+#   BENCH_PARTS="render spd build rays accel anim far pov pt dist adaptive"
 #   BENCH_FAR_RES=256 BENCH_FAR_N=65536   the far section's primary rays a side, and random rays
 #   BENCH_ROUNDS=3           rounds of turns between programs (ours and Embree
 #                            in the accel section, ours and POV-Ray, kd and
@@ -160,7 +163,7 @@ FLAKE_SIZE=${BENCH_FLAKE_SIZE:-}
 FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
-PARTS=${BENCH_PARTS:-render spd build rays accel anim far pov pt dist}
+PARTS=${BENCH_PARTS:-render spd build rays accel anim far pov pt dist adaptive}
 SPD_DIR=${BENCH_SPD_DIR:-scenes/spd}
 POV_DIR=${BENCH_POV_DIR:-../shared/spd/pov}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
@@ -215,7 +218,7 @@ for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N $ROUNDS $RAYS_ROUNDS $FAR_RES
 done
 [ "$ROUNDS" -le 9 ] || die "BENCH_ROUNDS must be at most 9 (raybench anim's limit), not $ROUNDS"
 for p in $PARTS; do
-  case $p in render|spd|build|rays|accel|anim|far|pov|pt|dist) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim far pov pt dist)";; esac
+  case $p in render|spd|build|rays|accel|anim|far|pov|pt|dist|adaptive) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim far pov pt dist adaptive)";; esac
 done
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT" || die "cannot create $OUT"
@@ -1102,6 +1105,19 @@ if part dist; then
     cat "$OUT/dist.txt" >>"$OUT/bench.txt"
   else
     echo "the distribution-effects section failed" | tee -a "$OUT/bench.txt"
+    status=1
+  fi
+  echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
+  echo | tee -a "$OUT/bench.txt"
+fi
+
+# ------------------------------------------------- adaptive sampling
+if part adaptive; then
+  t_part=$SECONDS
+  if CC="$CC" CFLAGS="$CFLAGS" BENCH_ROUNDS="$ROUNDS" bash bench/adaptive.sh; then
+    cat "$OUT/adaptive.txt" >>"$OUT/bench.txt"
+  else
+    echo "the adaptive-sampling section failed" | tee -a "$OUT/bench.txt"
     status=1
   fi
   echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
