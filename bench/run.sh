@@ -1099,30 +1099,22 @@ if part pt; then
 fi
 
 # ------------------------------------------------- distribution effects
-if part dist; then
-  t_part=$SECONDS
-  if CC="$CC" CFLAGS="$CFLAGS" bash bench/dist.sh; then
-    cat "$OUT/dist.txt" >>"$OUT/bench.txt"
+# own_script NAME WHAT: bench/NAME.sh, its table appended to bench.txt
+own_script() {
+  local t_part=$SECONDS
+  if CC="$CC" CFLAGS="$CFLAGS" BENCH_ROUNDS="$ROUNDS" bash "bench/$1.sh"; then
+    cat "$OUT/$1.txt" >>"$OUT/bench.txt"
   else
-    echo "the distribution-effects section failed" | tee -a "$OUT/bench.txt"
+    echo "the $2 section failed" | tee -a "$OUT/bench.txt"
     status=1
   fi
   echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
   echo | tee -a "$OUT/bench.txt"
-fi
+}
+part dist && own_script dist distribution-effects
 
 # ------------------------------------------------- adaptive sampling
-if part adaptive; then
-  t_part=$SECONDS
-  if CC="$CC" CFLAGS="$CFLAGS" BENCH_ROUNDS="$ROUNDS" bash bench/adaptive.sh; then
-    cat "$OUT/adaptive.txt" >>"$OUT/bench.txt"
-  else
-    echo "the adaptive-sampling section failed" | tee -a "$OUT/bench.txt"
-    status=1
-  fi
-  echo "($((SECONDS - t_part)) s)" | tee -a "$OUT/bench.txt"
-  echo | tee -a "$OUT/bench.txt"
-fi
+part adaptive && own_script adaptive adaptive-sampling
 
 # ---------------------------------------------------------------- targets
 if [ ${#targets[@]} -gt 0 ]; then
