@@ -45,6 +45,9 @@ void usage(FILE *to)
           "  --adaptive E  samples in doubling rounds (Whitted's from 8, the path\n"
           "             tracer's from 16) up to -n: a pixel stops once its byte is known\n"
           "             to within E steps with 95% confidence, by its own samples\n"
+          "  --no-skip  skip nothing the plain algorithm does: Whitted's rays of tiny\n"
+          "             weight, shadow rays to lights behind a surface, the shadow cache,\n"
+          "             the loop instead of a structure for a few objects, --adaptive\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
           "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
           "             card's; a path-traced image always has it, but for PFM and EXR)\n"
@@ -244,6 +247,7 @@ int parse_args(int argc, char **argv, Args *a)
         else if (!strcmp(o, "--pt")) a->integrator = 1;
         else if (!strcmp(o, "--whitted")) a->integrator = 0;
         else if (!strcmp(o, "--no-roulette")) a->roulette = 0;
+        else if (!strcmp(o, "--no-skip")) a->no_skip = 1;
         else if ((v = option_value(argc, argv, &i, "--seed"))) a->seed = int_arg("--seed", v, 0, 2147483647);
         else if ((v = option_value(argc, argv, &i, "--estimator"))) a->estimator = estimator_arg(v);
         else if ((v = option_value(argc, argv, &i, "--adaptive"))) a->adaptive = steps_arg("--adaptive", v);
@@ -305,6 +309,7 @@ static void print_stats_kv(FILE *f, const Stats *st)
             "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
             all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced,
             st->cut, st->discarded);
+    fprintf(f, "no_skip %d\n", st->no_skip);
     if (st->adaptive > 0)
         fprintf(f, "adaptive_steps %g\nsamples_per_pixel %.4f\nsamples_min %d\nsamples_max %d\n",
                 st->adaptive, (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max);
@@ -372,6 +377,9 @@ void print_stats(FILE *f, const Stats *st, int kv)
     if (!st->path && st->cut)
         fprintf(f, "budget     %llu reflected or refracted rays not traced: past %d a primary ray\n",
                 st->cut, st->budget);
+    if (!st->path)
+        fprintf(f, "skips      %s\n", st->no_skip ? "none (--no-skip)" : "rays of weight under 1/512, shadow rays"
+                " to lights behind, tested blockers first (the shadow cache)");
     if (st->adaptive > 0)
         fprintf(f, "adaptive   to %g steps: %.2f samples a pixel, from %d to %d (of %d)\n", st->adaptive,
                 (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max, st->spp);

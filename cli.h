@@ -29,6 +29,7 @@ typedef struct {
     int roulette;           /* 0 after --no-roulette */
     int view;               /* --view; 0: the picture itself */
     double adaptive;        /* --adaptive E; 0: every pixel takes every sample */
+    int no_skip;            /* --no-skip */
     long seed;              /* --seed; -1: not given */
     char *made;             /* what parse_args allocated (the default output name) */
 } Args;
@@ -67,6 +68,7 @@ typedef struct {
     unsigned long long queries, nearest, hits, tests, steps;
     int budget;                     /* Whitted: secondary rays a primary ray may spawn */
     double adaptive;                /* --adaptive's E, or 0 */
+    int no_skip;                    /* --no-skip: every skip off */
     unsigned long long samples;     /* the samples all pixels took */
     int spp_min, spp_max;           /* the fewest and the most a pixel took */
     double load, build, seconds, cpu;   /* seconds: reading, building, rendering; cpu: rendering */

@@ -241,6 +241,7 @@ typedef struct {
     int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, or 0 */
     real adaptive;            /* --adaptive E: a pixel stops when its byte is known to E steps (0: off) */
     int srgb;                 /* the bytes go through the sRGB curve (for adaptive's rule) */
+    int no_skip;              /* --no-skip: no work skipped that the plain algorithm does */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
     const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
 } Settings;
@@ -479,7 +480,7 @@ static void area_point(const Worker *wk, int l, int q, real *u, real *v);
 static vec glossy_mirror(vec mirror, real shine, const Worker *wk);
 static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real *e,
                       vec *to_light, Worker *wk);
-static int worth_tracing(real k, real weight, int depth, Worker *wk);
+static int worth_tracing(const Scene *s, real k, real weight, int depth, Worker *wk);
 static vec reflect(vec d, vec n, real cosi);
 static int refract(vec d, vec n, real cosi, real eta, vec *t);
 
@@ -1168,11 +1169,11 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
     if (m->shine > 0) c = comb(m->ks, spec, c); /* highlight */
     dir = m->spread ? glossy_mirror(mirror, m->shine, wk) : mirror;
     if ((!m->spread || dot(dir, h->ng) * dot(mirror, h->ng) > 0)     /* a glossy ray may fall */
-        && worth_tracing(kr, weight, depth, wk)) {                  /* behind: it is lost */
+        && worth_tracing(s, kr, weight, depth, wk)) {                  /* behind: it is lost */
         wk->count.reflected++;
         c = comb(kr, trace(s, spawn(s, h, dir), depth - 1, kr * weight, wk), c);
     }
-    if (!tir && worth_tracing(m->kt, weight, depth, wk)) {
+    if (!tir && worth_tracing(s, m->kt, weight, depth, wk)) {
         wk->count.refracted++;
         c = comb(m->kt, trace(s, spawn(s, h, refracted), depth - 1, m->kt * weight, wk), c);
     }
@@ -1219,8 +1220,8 @@ static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker 
             area_point(wk, l, q, &u, &v);
             sample_emitter(s, l, h->p, n, h->time, u, v, &wi, &dist, &Le, &pdf);
             e = dot(n, wi);
-            if (!(pdf > 0) || !(e > 0)) continue;   /* facing away: no ray */
-            if (!light_visible(s, h, l, wi, dist, wk)) continue;
+            if (!(pdf > 0) || (!(e > 0) && !s->set.no_skip)) continue;   /* facing away: no ray */
+            if (!light_visible(s, h, l, wi, dist, wk) || !(e > 0)) continue;
             *color = comb(e / ((real)PI * pdf * s->shadow_rays), Le, *color);
         }
     }
@@ -1262,15 +1263,18 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
     vec dir = *to_light = unit(sub(l->pos, from));
     Ray r;
     Hit blocker;
+    int seen;
     real k = l->sphere >= 0 ? s->mat[s->sph[l->sphere].mat].kl : 1;
     *e = k * dot(n, dir);
-    if (!(*e > 0)) return 0;    /* facing away: no ray, as the SPD rules say */
+    if (!(*e > 0) && !s->set.no_skip) return 0;    /* facing away: no ray, as the SPD rules say */
     wk->count.shadow++;
     r = spawn(s, h, dir);
     if (l->sphere < 0)          /* a point light: anything before it blocks */
-        return !any_hit(s, r, sqrt(dot(sub(l->pos, r.o), sub(l->pos, r.o))),
+        seen = !any_hit(s, r, sqrt(dot(sub(l->pos, r.o), sub(l->pos, r.o))),
                         &wk->blocker[(l - s->light) % SHADOW_SLOTS], wk);
-    return nearest_hit(s, r, &blocker, wk) && blocker.obj == l->sphere;
+    else
+        seen = nearest_hit(s, r, &blocker, wk) && blocker.obj == l->sphere;
+    return seen && *e > 0;      /* --no-skip traces a light behind the surface too: it lights nothing */
 }
 
 /* Whether to trace a secondary ray that adds k times its colour to a hit
@@ -1285,11 +1289,12 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
  * all.  So a primary ray's tree also has a budget, RAY_BUDGET reflected and
  * refracted rays, spent depth first; what it cannot pay for is not traced
  * and is counted (--stats).  Ordinary scenes never reach it: depth 5, the
- * SPD's, allows at most 30. */
+ * SPD's, allows at most 30.  --no-skip traces every ray of weight above 0
+ * (the budget stays: it is what keeps a render finite).  */
 #define MIN_WEIGHT (1.0 / 512)
-static int worth_tracing(real k, real weight, int depth, Worker *wk)
+static int worth_tracing(const Scene *s, real k, real weight, int depth, Worker *wk)
 {
-    if (!(k > 0 && depth > 1 && k * weight >= MIN_WEIGHT)) return 0;
+    if (!(k > 0 && depth > 1 && (k * weight >= MIN_WEIGHT || s->set.no_skip))) return 0;
     if (wk->budget > 0) { wk->budget--; return 1; }
     wk->count.cut++;
     return 0;
@@ -2142,7 +2147,7 @@ static int any_hit(const Scene *s, Ray r, real tmax, int *last, Worker *wk)
     int hit;
     Query q;
     wk->count.queries++;
-    if (s->accel.which != ACCEL_NONE && *last >= 0) {
+    if (s->accel.which != ACCEL_NONE && *last >= 0 && !s->set.no_skip) {
         wk->count.tests++;
         if (hit_object(s, *last, &r, tmax, &t)) return 1;
     }
@@ -2341,7 +2346,7 @@ static int build_accel(Scene *s, const char *accel)
     s->accel.prims.user = s;
     s->accel.prims.eps = REAL_EPS;              /* the hit callback's arithmetic (prims.h) */
     s->accel.which = ACCEL_NONE;
-    if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM)) return 1;
+    if (!strcmp(accel, "none") || (!strcmp(accel, "auto") && nobj(s) < TREE_FROM && !s->set.no_skip)) return 1;
     if (!float_range(s)) {
         fprintf(stderr, "ray: warning: coordinates beyond the float range the structures keep their"
                 " boxes and planes in (above 1e37, or a scene within 1e-30 of the origin): every ray"
@@ -3376,6 +3381,7 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.refracted = c->refracted, st.bounced = c->bounced, st.cut = c->cut, st.budget = RAY_BUDGET;
     st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
     st.hits = c->hits, st.tests = c->tests, st.steps = c->steps;
+    st.no_skip = s->set.no_skip;
     st.adaptive = s->set.adaptive, st.samples = c->samples, st.spp_min = c->spp_min, st.spp_max = c->spp_max;
     st.load = load, st.build = build, st.seconds = seconds, st.cpu = cpu;
     print_stats(stderr, &st, kv);
@@ -3504,6 +3510,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s: an OBJ mesh alone: grey, seen by a camera framing its box (y up),"
                 " lit by one light\n", a.scene);
     if (a.depth) s.set.depth = s.set.max_rays = a.depth;
+    s.set.no_skip = a.no_skip;
     accel = a.accel ? a.accel : s.set.accel_line ? s.set.accel_line : "auto";
     if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {
         free_scene(&s); free(a.made);
@@ -3519,7 +3526,7 @@ int main(int argc, char **argv)
     if (!ok || !open_output(&out, a.output)) { free_scene(&s); free(a.made); return 1; }
 
     s.set.view = a.view;
-    s.set.adaptive = (real)a.adaptive;
+    s.set.adaptive = a.no_skip ? 0 : (real)a.adaptive;
     s.set.srgb = s.set.integrator == PATH || a.gamma;
     if (a.view == VIEW_DEPTH) s.set.far = farthest(&s);
     if (!new_image(&img, s.set.w, s.set.h, float_format(out.format), !a.view && (s.set.integrator == PATH || a.gamma))) {

@@ -88,3 +88,22 @@ smallpt.sph  | -s 24x24 -n 1   | 6.0   7.4   0.9  | 5.40  6.68  0.73
 caustic.sph  | -s 24x24 -n 1   | 4.0   5.8   1.1  | 3.60  5.23  0.98
 bleed.sph    | -s 24x24 -n 1   | 3.8   2.8   5.8  | 3.45  2.51  5.22
 BOUNDS
+
+# --no-skip: the plain algorithm's work.  Every shading point sends a shadow
+# ray to every point light (none is skipped for facing away, no cache
+# answers first), so on scenes lit by point lights alone the shadow rays
+# are exactly the lights times the shading points (the hits of primary,
+# reflected and refracted rays); the rays of weight under 1/512 are traced
+# too (whitted.sph has some), and the image stays within a step of the
+# default one; --stats says so.
+for f in scenes/whitted.sph "$TMP/balls.nff"; do
+  ./ray --accel kd --no-skip -s 64x48 --stats=kv -o "$TMP/ns.ppm" "$f" 2>"$TMP/ns.kv" >/dev/null
+  ./ray --accel kd -s 64x48 --stats=kv -o "$TMP/sk.ppm" "$f" 2>"$TMP/sk.kv" >/dev/null
+  read -r lights shadow hits skip refl <<<"$(for k in point_lights rays_shadow hits no_skip rays_reflected; do sed -n "s/^$k //p" "$TMP/ns.kv"; done | tr '\n' ' ')"
+  refl0=$(sed -n 's/^rays_reflected //p' "$TMP/sk.kv")
+  [ -n "$lights" ] && [ "$shadow" = $((lights * hits)) ] && [ "$skip" = 1 ] && [ "$refl" -ge "$refl0" ] \
+    && { [ "$f" != scenes/whitted.sph ] || [ "$refl" -gt "$refl0" ]; } \
+    && tools/ppmdiff -t 1 "$TMP/ns.ppm" "$TMP/sk.ppm" >/dev/null 2>&1 \
+    && ok "--no-skip on $(basename "$f"): $shadow shadow rays = $lights lights x $hits shading points; $refl reflected rays against $refl0; within a step of the default image" \
+    || bad "--no-skip on $(basename "$f"): shadow '$shadow', lights '$lights', hits '$hits', no_skip '$skip'"
+done
