@@ -340,6 +340,8 @@ typedef struct {
     unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
     unsigned long long bounced, discarded;      /* path tracer: BSDF-sampled rays; bad samples */
     unsigned long long cut;                     /* Whitted: rays past a primary ray's budget */
+    unsigned long long behind, faint;           /* Whitted's skips: shadow rays to lights behind, */
+                                                /* rays of too little weight (see worth_tracing) */
     unsigned long long samples;                 /* samples the pixels took, all together; */
     int spp_min, spp_max;                       /* the fewest and most one pixel took (0: none yet) */
     int threads;                                /* how many threads rendered */
@@ -1220,7 +1222,8 @@ static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker 
             area_point(wk, l, q, &u, &v);
             sample_emitter(s, l, h->p, n, h->time, u, v, &wi, &dist, &Le, &pdf);
             e = dot(n, wi);
-            if (!(pdf > 0) || (!(e > 0) && !s->set.no_skip)) continue;   /* facing away: no ray */
+            if (!(pdf > 0)) continue;
+            if (!(e > 0) && !s->set.no_skip) { wk->count.behind++; continue; }   /* facing away: no ray */
             if (!light_visible(s, h, l, wi, dist, wk) || !(e > 0)) continue;
             *color = comb(e / ((real)PI * pdf * s->shadow_rays), Le, *color);
         }
@@ -1266,7 +1269,7 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
     int seen;
     real k = l->sphere >= 0 ? s->mat[s->sph[l->sphere].mat].kl : 1;
     *e = k * dot(n, dir);
-    if (!(*e > 0) && !s->set.no_skip) return 0;    /* facing away: no ray, as the SPD rules say */
+    if (!(*e > 0) && !s->set.no_skip) return wk->count.behind++, 0;  /* facing away: no ray (the SPD's rule) */
     wk->count.shadow++;
     r = spawn(s, h, dir);
     if (l->sphere < 0)          /* a point light: anything before it blocks */
@@ -1294,7 +1297,8 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
 #define MIN_WEIGHT (1.0 / 512)
 static int worth_tracing(const Scene *s, real k, real weight, int depth, Worker *wk)
 {
-    if (!(k > 0 && depth > 1 && (k * weight >= MIN_WEIGHT || s->set.no_skip))) return 0;
+    if (!(k > 0 && depth > 1)) return 0;
+    if (!(k * weight >= MIN_WEIGHT || s->set.no_skip)) return wk->count.faint++, 0;
     if (wk->budget > 0) { wk->budget--; return 1; }
     wk->count.cut++;
     return 0;
@@ -2929,6 +2933,8 @@ static void add_counts(Counts *to, const Counts *from)
     to->bounced += from->bounced;
     to->discarded += from->discarded;
     to->cut += from->cut;
+    to->behind += from->behind;
+    to->faint += from->faint;
     to->samples += from->samples;
     if (from->spp_max && (!to->spp_max || from->spp_min < to->spp_min)) to->spp_min = from->spp_min;
     if (from->spp_max > to->spp_max) to->spp_max = from->spp_max;
@@ -3381,7 +3387,7 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.refracted = c->refracted, st.bounced = c->bounced, st.cut = c->cut, st.budget = RAY_BUDGET;
     st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
     st.hits = c->hits, st.tests = c->tests, st.steps = c->steps;
-    st.no_skip = s->set.no_skip;
+    st.no_skip = s->set.no_skip, st.behind = c->behind, st.faint = c->faint;
     st.adaptive = s->set.adaptive, st.samples = c->samples, st.spp_min = c->spp_min, st.spp_max = c->spp_max;
     st.load = load, st.build = build, st.seconds = seconds, st.cpu = cpu;
     print_stats(stderr, &st, kv);
