@@ -87,7 +87,7 @@
  *       write_image()     the image to its file                     (image.c)
  *
  * One path-traced sample, in the Cornell box (a triangle lit by a
- * triangle; 15 marked ^ of 47):
+ * triangle; 14 marked ^ of 48):
  *
  *       main(), ^ render(), ^ render_row()                          as above
  *       pixel_radiance()  the mean of the pixel's samples           Kajiya
@@ -106,9 +106,10 @@
  *     ^ bounce_random()   this bounce's numbers                     samples
  *       choose_light()    a light, by its power                     Kajiya
  *       sample_emitter()  a point on it
- *       triangle_sample() on the lamp's triangle                    the primitives
- *     ^ uniform_triangle() its warp                                 samples
- *       triangle_pdf()    and its pdf, in solid angle               the primitives
+ *       triangle_light_sample()  on the lamp's triangle             the primitives
+ *       spherical_triangle()     as seen from the point
+ *       spherical_triangle_sample()  a direction in it (Arvo)
+ *       triangle_light_pdf()     and its pdf, in solid angle
  *     ^ light_choice()    the chance it was chosen                  Kajiya
  *       bsdf_eval()       f there
  *     ^ light_visible()   the shadow ray: is the light seen?
@@ -567,6 +568,10 @@ static int triangle_clip(const Scene *s, const Triangle *tr, const double blo[3]
                          const double bhi[3], double lo[3], double hi[3]);
 static void triangle_sample(const Triangle *tr, real u, real v, vec *y, vec *ny);
 static real triangle_pdf(const Triangle *tr, real dist, real cosy);
+static void triangle_light_sample(const Triangle *tr, vec x, real u, real v, vec *y, vec *ny);
+static real triangle_light_pdf(const Triangle *tr, vec x, real dist, real cosy);
+static real spherical_triangle(const Triangle *tr, vec x, vec c[3], real angle[3]);
+static vec spherical_triangle_sample(const vec c[3], const real angle[3], real area, real u1, real u2);
 
 /* ---------------------------------------------------------- for each pixel */
 
@@ -1684,10 +1689,10 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u
         *pdf = sphere_sample(&s->sph[k], x, u, v, wi, dist);
         m = &s->mat[s->sph[k].mat];
     } else {
-        triangle_sample(&s->tri[k], u, v, &y, &ny);
+        triangle_light_sample(&s->tri[k], x, u, v, &y, &ny);
         *dist = sqrt(dot(sub(y, x), sub(y, x)));
         *wi = scale(1 / *dist, sub(y, x));
-        *pdf = triangle_pdf(&s->tri[k], *dist, dot(*wi, ny));
+        *pdf = triangle_light_pdf(&s->tri[k], x, *dist, dot(*wi, ny));
         m = &s->mat[s->tri[k].mat];
         if (!front_emits(s, e->obj, ny, scale(-1, *wi))) *pdf = 0;
     }
@@ -1712,7 +1717,7 @@ static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny, real t
     if (e->type == SPHERE_LIGHT) return light_choice(s, l) * sphere_pdf(&s->sph[k], x, y);
     d = sub(y, x);
     dist = sqrt(dot(d, d));
-    return light_choice(s, l) * triangle_pdf(&s->tri[k], dist, dot(d, ny) / dist);
+    return light_choice(s, l) * triangle_light_pdf(&s->tri[k], x, dist, dot(d, ny) / dist);
 }
 
 /* Whether object i, with front normal ng, emits towards wo: a one-sided
@@ -2881,6 +2886,78 @@ static real triangle_pdf(const Triangle *tr, real dist, real cosy)
 {
     vec n = cross(tr->e1, tr->e2);
     return uniform_triangle_pdf(sqrt(dot(n, n)) / 2) * dist * dist / fabs(cosy);
+}
+
+/* A triangle light seen from x: sampled by the solid angle it fills where
+ * that is at least SOLID_ANGLE_FROM (Arvo's method, below), so that every
+ * direction towards it is as likely; else by its area, where the two
+ * differ little (a small or far triangle's dist^2 / cos hardly changes
+ * over it) and Arvo's angles lose their precision as the triangle shrinks
+ * to a point.  The rule depends on x and the triangle alone, so that
+ * light_pdf finds the pdf sample_emitter used. */
+#define SOLID_ANGLE_FROM 0.01
+static void triangle_light_sample(const Triangle *tr, vec x, real u, real v, vec *y, vec *ny)
+{
+    vec c[3], wi;
+    real angle[3], area = spherical_triangle(tr, x, c, angle);
+    if (!(area >= SOLID_ANGLE_FROM)) {
+        triangle_sample(tr, u, v, y, ny);
+        return;
+    }
+    wi = spherical_triangle_sample(c, angle, area, u, v);
+    *ny = unit(cross(tr->e1, tr->e2));
+    *y = comb(dot(sub(tr->v0, x), *ny) / dot(wi, *ny), wi, x);   /* where wi meets the plane */
+}
+
+/* The triangle projected onto the unit sphere round x: c, the unit vectors
+ * to its corners; angle, the spherical triangle's angle at each (between
+ * the great arcs to the other two); returns its area, the solid angle,
+ * angle[0] + angle[1] + angle[2] - pi (Girard's theorem); 0 when a corner
+ * is x or two corners are seen in one direction. */
+static real spherical_triangle(const Triangle *tr, vec x, vec c[3], real angle[3])
+{
+    int i;
+    c[0] = unit(sub(tr->v0, x));
+    c[1] = unit(sub(add(tr->v0, tr->e1), x));
+    c[2] = unit(sub(add(tr->v0, tr->e2), x));
+    for (i = 0; i < 3; i++) {
+        vec a = c[i], b = c[(i + 1) % 3], d = c[(i + 2) % 3];
+        vec tb = sub(b, scale(dot(a, b), a)), td = sub(d, scale(dot(a, d), a));   /* the arcs' tangents */
+        if (!(dot(tb, tb) > 0 && dot(td, td) > 0)) return 0;
+        angle[i] = acos(fmax(-1, fmin(1, dot(unit(tb), unit(td)))));
+    }
+    return angle[0] + angle[1] + angle[2] - (real)PI;
+}
+
+/* A direction uniform in the spherical triangle c (angles angle, area
+ * area) from u1, u2: Arvo, "Stratified sampling of spherical triangles",
+ * SIGGRAPH 1995.  u1 chooses the sub-triangle A B C' of area u1 times the
+ * whole, by where its third corner C' lies on the arc from A to C (a
+ * closed form from the area's formula); u2 then a point on the arc from B
+ * to C', by the cosine of its distance from B, which makes it uniform in
+ * area.  Each step is a bijection, so stratified u1, u2 stay stratified. */
+static vec spherical_triangle_sample(const vec c[3], const real angle[3], real area, real u1, real u2)
+{
+    vec A = c[0], B = c[1], C = c[2], Cs, t;
+    real alpha = angle[0], sub_area = u1 * area, sn = sin(sub_area - alpha), cs = cos(sub_area - alpha);
+    real uu = cs - cos(alpha), vv = sn + sin(alpha) * dot(A, B);
+    real q = ((vv * cs - uu * sn) * cos(alpha) - vv) / ((vv * sn + uu * cs) * sin(alpha)), z;
+    q = fmax(-1, fmin(1, q));                       /* the cosine of C' from A */
+    t = sub(C, scale(dot(C, A), A));
+    Cs = add(scale(q, A), scale(sqrt(fmax(0, 1 - q * q)), unit(t)));
+    z = 1 - u2 * (1 - dot(Cs, B));                  /* the cosine of the point from B */
+    t = sub(Cs, scale(dot(Cs, B), B));
+    if (!(dot(t, t) > 0)) return B;
+    return add(scale(z, B), scale(sqrt(fmax(0, 1 - z * z)), unit(t)));
+}
+
+/* Its pdf in solid angle, for a point at distance dist whose normal is at
+ * cosine cosy to the line of sight. */
+static real triangle_light_pdf(const Triangle *tr, vec x, real dist, real cosy)
+{
+    vec c[3];
+    real angle[3], area = spherical_triangle(tr, x, c, angle);
+    return area >= SOLID_ANGLE_FROM ? 1 / area : triangle_pdf(tr, dist, cosy);
 }
 
 /* Zero area (a repeated vertex, or three in a line) to within rounding: such
