@@ -365,6 +365,7 @@ typedef struct {
     const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
     long long *splat;           /* this thread's splat image (see splat()), or NULL */
     int taken;                  /* samples the last pixel took (--view samples) */
+    const struct Tally *first;  /* Whitted's --adaptive: every pixel's first 4 samples, or NULL */
 } Worker;
 
 /* Two hooks in render() for the integrators still to come.  prepass runs
@@ -433,7 +434,9 @@ static void box_union(double lo[3], double hi[3], const double lo2[3], const dou
 /* for each pixel */
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
-typedef struct { vec sum, sq; int n; } Tally;
+typedef struct Tally { vec sum, sq; int n; } Tally;
+static const Tally *take_samples(const Scene *s, int i, int j, Tally *t, int n, Worker *wk);
+static int neighbours_agree(const Scene *s, const Tally *first, int i, int j);
 static void tally(Tally *t, vec c);
 static int pixel_done(const Scene *s, const Tally *t, int first);
 static int settled(const Scene *s, const Tally *t);
@@ -591,13 +594,24 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 }
 
 /* The pixel's colour: RayTrace of each of its spp samples, averaged (with
- * --adaptive, of those it takes: from 8 on, see pixel_done). */
+ * --adaptive, of those it takes: see pixel_done and neighbours_agree). */
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
 {
     Tally t = { { 0, 0, 0 }, { 0, 0, 0 }, 0 };
+    if (wk->first) {                        /* --adaptive: the first 4 were taken before */
+        t = wk->first[(size_t)j * s->set.w + i];
+        if (neighbours_agree(s, wk->first, i, j)) return pixel_mean(&t, wk);
+    }
+    return pixel_mean(take_samples(s, i, j, &t, spp, wk), wk);
+}
+
+/* Samples t->n, t->n + 1, ... of the pixel into t, up to n in all or
+ * until pixel_done says it may stop (rounds from 8 on). */
+static const Tally *take_samples(const Scene *s, int i, int j, Tally *t, int n, Worker *wk)
+{
     real shift = s->moving ? time_shift(wk, s, i, j) : 0;   /* no motion: no numbers drawn */
     int k;
-    for (k = 0; k < spp && !pixel_done(s, &t, 8); k++) {
+    for (k = t->n; k < n && !pixel_done(s, t, 8); k++) {
         real dx, dy;
         Ray r;
         sample_offset(k, s->cam.anchor, &dx, &dy);
@@ -606,14 +620,15 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
         wk->budget = RAY_BUDGET;
         r = primary_ray(s, i + dx, j + dy, wk);
         if (s->moving) r.time = shutter_time(s, k, shift);
-        tally(&t, trace(s, r, s->set.depth, 1, wk));
+        tally(t, trace(s, r, s->set.depth, 1, wk));
         if (wk->hooks && wk->hooks->after_sample) wk->hooks->after_sample(s, i, j, k, wk, wk->hooks->data);
     }
-    return pixel_mean(&t, wk);
+    return t;
 }
 
 /* Adaptive sampling (--adaptive E).  A pixel's samples come in rounds
- * that double (Whitted's from 8, the path tracer's from 16), and at the end
+ * that double (from 8 in Whitted's renderer, 16 in the path tracer's; and
+ * Whitted's pixel may also stop at 4, see neighbours_agree), and at the end
  * of each the pixel stops if its byte is known to within E steps of 255
  * with 95% confidence: for each channel, the half-width 1.96 s / sqrt(n)
  * of the confidence interval of its mean (s the standard deviation of its
@@ -628,11 +643,11 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
  * be; the path tracer's 16 samples at least, and decisions only at the
  * ends of rounds, keep that to paths rarer than about one in 16 where the
  * rest agree.  Whitted's samples are the R2 points, not random, yet
- * spread evenly: where the first 8 agree (a flat wall, the sky) the
- * pixel is done; an edge, a shadow's or a refracted edge, makes them
- * disagree and the pixel goes on.  Not from 4: four points that agree
- * miss an edge that cuts a corner of the pixel often enough that the
- * image's error stops falling as -n grows. */
+ * spread evenly: where they agree (a flat wall, the sky) the pixel is
+ * done; an edge, a shadow's or a refracted edge, makes them disagree and
+ * the pixel goes on.  By its own samples alone, not at 4: four points
+ * that agree miss an edge that cuts a corner of the pixel often enough
+ * that the image's error stops falling as -n grows. */
 static void tally(Tally *t, vec c)
 {
     t->sum = add(t->sum, c);
@@ -659,6 +674,36 @@ static int settled(const Scene *s, const Tally *t)
         double half = 1.96 * sqrt(var / t->n), slope = s->set.srgb ? srgb_slope((real)fmax(0, mean - half)) : 1;
         if (mean - half < 1 && slope * half > s->set.adaptive / 255) return 0;
     }
+    return 1;
+}
+
+/* Whitted's pixel may stop at its first 4 samples (which render() takes
+ * for every pixel before the rest: first_samples) when they agree and so
+ * do each of its 8 neighbours', each within E steps of its own mean.  Four
+ * points alone often miss an edge through a corner of the pixel; the
+ * neighbour across that edge does not.  Every pixel's first 4 samples are
+ * the same whichever thread takes them, so the bytes still do not depend
+ * on the thread count. */
+static int neighbours_agree(const Scene *s, const Tally *first, int i, int j)
+{
+    const Tally *t = &first[(size_t)j * s->set.w + i];
+    int di, dj, c;
+    if (!settled(s, t)) return 0;
+    for (dj = -1; dj <= 1; dj++)
+        for (di = -1; di <= 1; di++) {
+            int a = i + di, b = j + dj;
+            const Tally *u;
+            double m[3], q[3];
+            if (a < 0 || b < 0 || a >= s->set.w || b >= s->set.h || (di == 0 && dj == 0)) continue;
+            u = &first[(size_t)b * s->set.w + a];
+            if (!settled(s, u)) return 0;
+            to3(scale((real)1 / t->n, t->sum), m);
+            to3(scale((real)1 / u->n, u->sum), q);
+            for (c = 0; c < 3; c++)
+                if (fmin(m[c], q[c]) < 1
+                    && fabs(m[c] - q[c]) * (s->set.srgb ? srgb_slope((real)fmin(m[c], q[c])) : 1) > s->set.adaptive / 255)
+                    return 0;
+        }
     return 1;
 }
 
@@ -3073,6 +3118,37 @@ static void add_splats(const Scene *s, const Options *o, long long **splats, int
         }
 }
 
+/* Whitted's --adaptive: every pixel's first 4 samples, taken before the
+ * rest (see neighbours_agree), on every thread; NULL when not needed. */
+static Tally *first_samples(const Scene *s, const Options *o, int nthreads, Counts *total)
+{
+    Tally *first;
+    (void)nthreads;                     /* without OpenMP: one */
+    if (!(s->set.adaptive > 0) || s->set.integrator != WHITTED || o->hooks || o->spp <= 4
+        || (s->set.view && s->set.view != VIEW_SAMPLES))
+        return NULL;
+    if (!(first = malloc((size_t)s->set.w * s->set.h * sizeof *first))) out_of_memory();
+    OMP(omp parallel num_threads(nthreads))
+    {
+        Worker wk;
+        int j;
+        memset(&wk, 0, sizeof wk);
+        OMP(omp for schedule(dynamic, 1))
+        for (j = 0; j < s->set.h; j++) {
+            int i;
+            for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
+            for (i = 0; i < s->set.w; i++) {
+                Tally *t = &first[(size_t)j * s->set.w + i];
+                memset(t, 0, sizeof *t);
+                take_samples(s, i, j, t, 4, &wk);
+            }
+        }
+        OMP(omp critical)
+        add_counts(total, &wk.count);
+    }
+    return first;
+}
+
 /* The whole image, row by row (render_row).  Rows go to threads one at a
  * time, as they free up; each pixel is written once by whoever computes it,
  * so the image does not depend on the order.  Each thread has its own
@@ -3083,12 +3159,14 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
 {
     int done = 0, stride = row_stride(s->set.h), nthreads = 1, splats = o->hooks && o->hooks->after_sample;
     long long **splat = NULL;
+    Tally *first;
     Image own = *img;
 #ifdef _OPENMP
     if (o->threads > 0) omp_set_num_threads(o->threads);
     nthreads = o->threads > 0 ? o->threads : omp_get_max_threads();
 #endif
     if (o->hooks && o->hooks->prepass) o->hooks->prepass(s, o->hooks->data);
+    first = first_samples(s, o, nthreads, total);
     if (splats) {
         int t;
         splat = calloc((size_t)nthreads, sizeof *splat);
@@ -3103,6 +3181,7 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         memset(&wk, 0, sizeof wk);
         wk.count.threads = 1;
         wk.hooks = o->hooks;
+        wk.first = first;
 #ifdef _OPENMP
         wk.count.threads = omp_get_num_threads();
         if (splats) wk.splat = splat[omp_get_thread_num()];
@@ -3131,6 +3210,7 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         free(splat);
         free_image(&own);
     }
+    free(first);
     if (o->progress) fprintf(stderr, "\r%30s\r", "");
 }
 

@@ -1,5 +1,6 @@
-# Adaptive sampling (--adaptive E): where a pixel's samples agree it stops
-# at the first round (Whitted's 8), where they disagree it goes on to -n;
+# Adaptive sampling (--adaptive E): where a pixel's samples agree, and (in
+# Whitted's renderer) its neighbours' first 4 agree with them, it stops at
+# 4; where they disagree it goes on to -n;
 # the bytes do not depend on the thread count; Whitted's image is nearer a
 # reference than uniform 16 samples are; the path tracer's mean stays
 # within 4 standard errors of a uniform render's; --stats and --view
@@ -10,9 +11,9 @@
 printf 'size 16 12\ncamera 0 0 -5 0 0 0 0 1 0 40\nambient .5 .5 .5\n0 0 0 .8 .6 .4 100 1 0 0 0 1\n' > "$TMP/flat.sph"
 ./ray -n 64 --adaptive 0.5 --stats=kv -o "$TMP/flat.ppm" "$TMP/flat.sph" 2>"$TMP/kv"
 ./ray -n 64 --adaptive 0.5 --view samples -o "$TMP/flat_n.ppm" "$TMP/flat.sph" 2>/dev/null
-grep -qx "samples_min 8" "$TMP/kv" && grep -qx "samples_max 8" "$TMP/kv" \
-  && python3 -c 'import sys; d=open(sys.argv[1],"rb").read()[-16*12*3:]; sys.exit(0 if set(d) == {32} else 1)' "$TMP/flat_n.ppm" \
-  && ok "a flat wall: every pixel stops at 8 of 64 samples (--stats=kv), and --view samples shows 8/64 grey" \
+grep -qx "samples_min 4" "$TMP/kv" && grep -qx "samples_max 4" "$TMP/kv" \
+  && python3 -c 'import sys; d=open(sys.argv[1],"rb").read()[-16*12*3:]; sys.exit(0 if set(d) == {16} else 1)' "$TMP/flat_n.ppm" \
+  && ok "a flat wall: every pixel stops at 4 of 64 samples (--stats=kv), and --view samples shows 4/64 grey" \
   || bad "a flat wall: $(grep samples_ "$TMP/kv" | tr '\n' ' ')"
 
 # scenes/whitted.sph at 80x60: edges go to -n; the image is nearer a
@@ -24,9 +25,17 @@ rmse() { tools/ppmdiff "$1" "$2" 2>/dev/null | sed -n 's/.*RMSE \([0-9.]*\).*/\1
 ra=$(rmse "$TMP/a.ppm" "$TMP/ref.ppm") ru=$(rmse "$TMP/u16.ppm" "$TMP/ref.ppm")
 line=$(grep '^adaptive ' "$TMP/st")
 [ -n "$ra" ] && [ -n "$ru" ] && awk -v a="$ra" -v u="$ru" 'BEGIN { exit !(a < 0.75 * u) }' \
-  && printf '%s\n' "$line" | grep -q "from 8 to 64 (of 64)" \
+  && printf '%s\n' "$line" | grep -q "from 4 to 64 (of 64)" \
   && ok "whitted.sph, --adaptive 0.5 -n 64: RMSE $ra steps against the 128-sample image, uniform 16 spp $ru; $line" \
   || bad "whitted.sph adaptive: RMSE '$ra' against uniform 16's '$ru'; $line"
+
+# Equal error for fewer samples: -n 64 --adaptive 16 reaches uniform 16's
+# RMSE with at most 9 samples a pixel (at this size edges are many).
+./ray -s 80x60 -n 64 --adaptive 16 --stats=kv -o "$TMP/a16.ppm" scenes/whitted.sph 2>"$TMP/kv16"
+r16=$(rmse "$TMP/a16.ppm" "$TMP/ref.ppm") spp16=$(sed -n 's/^samples_per_pixel //p' "$TMP/kv16")
+[ -n "$r16" ] && [ -n "$spp16" ] && awk -v a="$r16" -v u="$ru" -v n="$spp16" 'BEGIN { exit !(a <= u && n <= 9) }' \
+  && ok "whitted.sph, --adaptive 16 -n 64: RMSE $r16 steps (uniform 16: $ru) with $spp16 samples a pixel" \
+  || bad "whitted.sph, --adaptive 16 -n 64: RMSE '$r16' (uniform 16: '$ru'), '$spp16' samples a pixel"
 
 # The same bytes on 1 and 3 threads, in both renderers.
 ./ray -t 1 -s 40x30 -n 32 --adaptive 0.5 -o "$TMP/w1.ppm" scenes/whitted.sph 2>/dev/null
