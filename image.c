@@ -1069,12 +1069,11 @@ static int close_output(Output *o, int ok)
 static Exact exact_of(double v)
 {
     Exact e = { 0, 0 };
-    double a = fabs(v), whole;
+    double a = v < 0 ? -v : v;
     if (!(a > 0)) return e;
     if (a > 9.2e18) a = 9.2e18;
-    whole = floor(a);
-    e.hi = (uint64_t)whole;
-    e.lo = (uint64_t)ldexp(a - whole, 64);  /* a - whole is exact, below 1 */
+    e.hi = (uint64_t)(int64_t)a;            /* the whole part: conversion cuts toward 0 */
+    e.lo = (uint64_t)((a - (double)(int64_t)a) * 18446744073709551616.0);  /* the fraction, exact, x 2^64 */
     if (v < 0) {
         e.hi = ~e.hi + (e.lo == 0);
         e.lo = ~e.lo + 1;
@@ -1102,9 +1101,9 @@ double exact_value(const Exact *sum)
     if (e.hi >> 63) {                       /* negative: the value of its negation */
         e.hi = ~e.hi + (e.lo == 0);
         e.lo = ~e.lo + 1;
-        return -((double)e.hi + ldexp((double)e.lo, -64));
+        return -((double)e.hi + (double)e.lo / 18446744073709551616.0);
     }
-    return (double)e.hi + ldexp((double)e.lo, -64);
+    return (double)e.hi + (double)e.lo / 18446744073709551616.0;
 }
 
 static size_t partial_pixels(const Partial *p) { return (size_t)(p->x1 - p->x0) * (size_t)(p->y1 - p->y0); }

@@ -52,6 +52,29 @@ for r in W P D; do
   same "$r: ... and to its PPM" "$TMP/m.ppm" "$TMP/$r.ppm"
 done
 
+# The sums themselves: a pixel of 2 samples is the mean of its two
+# one-sample images (--samples 0:1, 1:2), by python's own arithmetic, to
+# within a float's rounding.
+for r in "scenes/cornell.sph --pt" "scenes/whitted.sph"; do
+  ./ray $r -s 40x30 -n 2 -o "$TMP/n2.pfm" 2>/dev/null
+  ./ray $r -s 40x30 -n 2 --samples 0:1 -o "$TMP/k0.pfm" 2>/dev/null
+  ./ray $r -s 40x30 -n 2 --samples 1:2 -o "$TMP/k1.pfm" 2>/dev/null
+  worst=$(python3 - "$TMP/n2.pfm" "$TMP/k0.pfm" "$TMP/k1.pfm" <<'EOF'
+import sys, struct
+def pfm(name):
+    d = open(name, 'rb').read()
+    head = d.split(b'\n', 3)
+    w, h = map(int, head[1].split())
+    return struct.unpack('<%df' % (3 * w * h), head[3][:12 * w * h])
+n2, a, b = map(pfm, sys.argv[1:])
+print('%.3g' % max(abs(x - (y + z) / 2) / max(1e-30, abs(x), 2 ** -60) for x, y, z in zip(n2, a, b)))
+EOF
+)
+  awk -v w="$worst" 'BEGIN { exit !(w != "" && w + 0 <= 2.4e-7) }' \
+    && ok "$r -n 2: each pixel is the mean of its samples 0:1 and 1:2 (worst relative difference $worst; two floats' rounding allow 2.4e-7)" \
+    || bad "$r -n 2: a pixel is not the mean of its two samples (worst relative difference '$worst')"
+done
+
 # --adaptive: each pixel's rounds are its own, Whitted's neighbours across
 # a crop's edge included; the same bytes as one adaptive run.
 for r in "scenes/whitted.sph -s 60x45 -n 32 --adaptive 2" "scenes/cornell.sph --pt -s 40x30 -n 64 --adaptive 4"; do
