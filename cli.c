@@ -2,6 +2,7 @@
  * exit status 2 for anything it cannot take, and the help text.
  */
 #include "posix.h"
+#include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,13 +23,14 @@
 void usage(FILE *to)
 {
     fputs("usage: ray [options] SCENE\n"
+          "       ray --merge OUT PART...    (the parts of a split render, as one image)\n"
           "Renders SCENE with Whitted ray tracing, or path tracing (--pt): the sphere\n"
           "format (README.md), or NFF (Eric Haines' Neutral File Format, the SPD\n"
           "scenes') when it ends .nff; an OBJ mesh alone, framed and lit, when it\n"
           "ends .obj; - reads the sphere format or NFF from standard input.\n"
           "  -o FILE    output image: PNG if FILE ends .png, PFM or OpenEXR (floats) if\n"
-          "             .pfm or .exr, else PPM (default: SCENE's base name + .ppm; - for\n"
-          "             stdout)\n"
+          "             .pfm or .exr, a partial render (sums, for --merge) if .part,\n"
+          "             else PPM (default: SCENE's base name + .ppm; - for stdout)\n"
           "  -s WxH     image size (default: the scene's `size`, else 512x512)\n"
           "  -n N       samples per pixel (default: the scene's `samples`, else 1)\n"
           "  -d N       Whitted: recursion depth, 1 = primary rays only (default: the\n"
@@ -49,6 +51,15 @@ void usage(FILE *to)
           "  --no-skip  skip nothing the plain algorithm does: Whitted's rays of tiny\n"
           "             weight, shadow rays to lights behind a surface, the shadow cache,\n"
           "             the loop instead of a structure for a few objects, --adaptive\n"
+          "  --crop X0,Y0,X1,Y1  render only the pixels X0 <= x < X1, Y0 <= y < Y1,\n"
+          "             with the values a whole render gives them\n"
+          "  --tile I/N job I (from 0) of N: the I-th of N bands of rows\n"
+          "  --samples A:B  only samples A <= k < B of each pixel's -n\n"
+          "  --merge    OUT PART...: add the parts (.part files) and write OUT, the\n"
+          "             same bytes as one whole run\n"
+          "  --checkpoint S  save the work so far every S seconds, and on SIGINT,\n"
+          "             SIGTERM or SIGHUP, as OUT.part (OUT: -o's file); removed when done\n"
+          "  --resume FILE  go on from a checkpoint, with the options it was made with\n"
           "  --p3       write plain-text P3 instead of binary P6\n"
           "  --gamma    encode Whitted's output with the sRGB curve (default: linear, as the\n"
           "             card's; a path-traced image always has it, but for PFM and EXR)\n"
@@ -66,7 +77,12 @@ void usage(FILE *to)
           "  --help     this text\n", to);
 }
 
-#define RAY_VERSION "1.0"
+#define RAY_VERSION "1.1"
+
+const char *program_version(void)
+{
+    return sizeof(REAL) == sizeof(float) ? "ray " RAY_VERSION " float" : "ray " RAY_VERSION " double";
+}
 
 static void version(void)
 {
@@ -129,6 +145,64 @@ static double steps_arg(const char *opt, const char *arg)
     if (!arg || end == arg || *end || !(v > 0 && v <= 255)) {
         fprintf(stderr, "ray: %s takes a number of 8-bit steps above 0, at most 255, not %s\n", opt,
                 arg ? arg : "nothing");
+        exit(2);
+    }
+    return v;
+}
+
+/* Whole numbers separated by sep ("," or ":" or "/"), n of them, each at
+ * least 0, into v; or exit with a message that shows the form. */
+static void numbers_arg(const char *opt, const char *arg, const char *sep, int n, const char *form, int *v)
+{
+    const char *p = arg;
+    int k;
+    for (k = 0; k < n; k++) {
+        char *end;
+        long x = strtol(p, &end, 10);
+        if (end == p || x < 0 || x > 1 << 30 || (k < n - 1 ? *end != *sep : *end != 0) || !isdigit((unsigned char)*p)) {
+            fprintf(stderr, "ray: %s takes %s (whole numbers, 0 or more), not %s\n", opt, form, arg);
+            exit(2);
+        }
+        v[k] = (int)x;
+        p = end + 1;
+    }
+}
+
+/* --crop, --tile and --samples into a; exit with a message when one
+ * cannot be right whatever the image (the image's size is checked later). */
+static void split_arg(Args *a, const char *opt, const char *v)
+{
+    if (!strcmp(opt, "--crop")) {
+        numbers_arg(opt, v, ",", 4, "X0,Y0,X1,Y1", a->crop);
+        a->cropped = 1;
+        if (a->crop[2] <= a->crop[0] || a->crop[3] <= a->crop[1]) {
+            fprintf(stderr, "ray: --crop %s holds no pixel: X1 must be above X0, Y1 above Y0\n", v);
+            exit(2);
+        }
+    } else if (!strcmp(opt, "--tile")) {
+        int t[2];
+        numbers_arg(opt, v, "/", 2, "I/N, job I (from 0) of N", t);
+        if (t[1] < 1 || t[0] >= t[1]) {
+            fprintf(stderr, "ray: --tile %s: I must be below N, from 0 (job 0 of 4 to job 3 of 4)\n", v);
+            exit(2);
+        }
+        a->tile = t[0], a->tiles = t[1];
+    } else {
+        numbers_arg(opt, v, ":", 2, "A:B, samples A <= k < B", a->samples);
+        if (a->samples[1] <= a->samples[0]) {
+            fprintf(stderr, "ray: --samples %s holds no sample: B must be above A\n", v);
+            exit(2);
+        }
+    }
+}
+
+/* A number of seconds above 0, or exit with a message. */
+static double seconds_arg(const char *opt, const char *arg)
+{
+    char *end;
+    double v = strtod(arg, &end);
+    if (end == arg || *end || !(v > 0 && v < 1e9)) {
+        fprintf(stderr, "ray: %s takes a number of seconds above 0, not %s\n", opt, arg);
         exit(2);
     }
     return v;
@@ -221,6 +295,46 @@ static int parse_size(const char *size, int *w, int *h)
     return 1;
 }
 
+/* ray --merge OUT PART...: only --p3 besides (for OUT); OUT no part. */
+static int merge_args(Args *a)
+{
+    int i;
+    if (a->nparts < 2) {
+        fprintf(stderr, "ray: --merge needs OUT and at least one part: ray --merge OUT PART...\n");
+        return 2;
+    }
+    if (a->output || a->w || a->spp || a->cropped || a->tiles || a->samples[1] || a->checkpoint || a->resume) {
+        fprintf(stderr, "ray: --merge takes OUT and the parts (and --p3); the parts say how they were made\n");
+        return 2;
+    }
+    a->output = a->parts[0];
+    if (!output_usable(a->output, a->plain)) return 2;
+    if (output_format(a->output) == FORMAT_PART) {
+        fprintf(stderr, "ray: --merge writes an image (.ppm, .png, .pfm, .exr), not %s\n", a->output);
+        return 2;
+    }
+    for (i = 1; i < a->nparts; i++)
+        if (same_file(a->parts[i], a->output)) {
+            fprintf(stderr, "ray: --merge %s would overwrite its part %s\n", a->output, a->parts[i]);
+            return 2;
+        }
+    return -1;
+}
+
+/* The split options together: one way to choose the pixels, checkpoints
+ * to a file; else a message (a usage error). */
+static int split_args_fit(const Args *a)
+{
+    const char *why = a->cropped && a->tiles ? "--crop and --tile both choose the pixels: give one"
+                      : a->checkpoint && !strcmp(a->output, "-") ? "--checkpoint needs -o FILE: it saves to FILE.part"
+                      : (a->view && (a->samples[1] || a->checkpoint || a->resume || output_format(a->output) == FORMAT_PART))
+                        ? "--view draws one ray a pixel: it has no samples to split, save or merge"
+                      : a->resume && same_file(a->resume, a->output) ? "--resume's file is -o's: it would be overwritten"
+                      : NULL;
+    if (why) fprintf(stderr, "ray: %s\n", why);
+    return !why;
+}
+
 /* The options in any order, then one scene.  A value may be attached
  * ("-n4", "--accel=kd") or follow ("-n 4"). */
 int parse_args(int argc, char **argv, Args *a)
@@ -252,17 +366,32 @@ int parse_args(int argc, char **argv, Args *a)
         else if ((v = option_value(argc, argv, &i, "--seed"))) a->seed = int_arg("--seed", v, 0, 2147483647);
         else if ((v = option_value(argc, argv, &i, "--estimator"))) a->estimator = estimator_arg(v);
         else if ((v = option_value(argc, argv, &i, "--adaptive"))) a->adaptive = steps_arg("--adaptive", v);
+        else if ((v = option_value(argc, argv, &i, "--crop"))) split_arg(a, "--crop", v);
+        else if ((v = option_value(argc, argv, &i, "--tile"))) split_arg(a, "--tile", v);
+        else if ((v = option_value(argc, argv, &i, "--samples"))) split_arg(a, "--samples", v);
+        else if ((v = option_value(argc, argv, &i, "--checkpoint"))) a->checkpoint = seconds_arg("--checkpoint", v);
+        else if ((v = option_value(argc, argv, &i, "--resume"))) a->resume = v;
+        else if (!strcmp(o, "--merge")) a->merge = 1;
         else if (o[0] == '-' && o[1]) {
             fprintf(stderr, "ray: unknown option: %s\n", o);
             usage(stderr);
             return 2;
-        } else if (a->scene) {
+        } else if (a->merge || !a->scene) {
+            if (!a->parts && !(a->parts = malloc(sizeof *a->parts * (size_t)argc))) return 2;
+            a->parts[a->nparts++] = o;  /* the scene, or --merge's OUT and parts */
+            a->scene = a->parts[0];
+        } else {
             fprintf(stderr, "ray: one scene only (%s and %s)\n", a->scene, o);
             return 2;
-        } else
-            a->scene = o;
+        }
     }
+    if (a->merge) return merge_args(a);
     if (!a->scene) { usage(stderr); return 2; }
+    if (a->nparts > 1) {
+        fprintf(stderr, "ray: one scene only (%s and %s)\n", a->parts[0], a->parts[1]);
+        return 2;
+    }
+    if (!split_args_fit(a)) return 2;
     a->name = strcmp(a->scene, "-") ? a->scene : "stdin";
     if (!a->output) a->output = a->made = default_output(a->name);
     if (!output_usable(a->output, a->plain) || (strcmp(a->scene, "-") && !apart(a->scene, a->output))) {

@@ -31,6 +31,14 @@ typedef struct {
     double adaptive;        /* --adaptive E; 0: every pixel takes every sample */
     int no_skip;            /* --no-skip */
     long seed;              /* --seed; -1: not given */
+    int crop[4], cropped;   /* --crop X0,Y0,X1,Y1 */
+    int tile, tiles;        /* --tile I/N; tiles 0: not given */
+    int samples[2];         /* --samples A:B; B 0: not given */
+    double checkpoint;      /* --checkpoint S; 0: none */
+    const char *resume;     /* --resume FILE, or NULL */
+    int merge;              /* --merge: parts[0] is OUT, parts[1..] the parts */
+    const char **parts;     /* the arguments that are no options (freed by the caller) */
+    int nparts;
     char *made;             /* what parse_args allocated (the default output name) */
 } Args;
 
@@ -44,6 +52,9 @@ int parse_args(int argc, char **argv, Args *a);
 char *default_output(const char *scene);
 
 void usage(FILE *to);
+
+/* "ray 1.1 double" (or float): the version, and the build's arithmetic. */
+const char *program_version(void);
 
 /* Seconds on a wall clock (processor time where there is none). */
 double now(void);

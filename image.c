@@ -10,6 +10,7 @@
 #include "posix.h"
 #include <ctype.h>
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -69,6 +70,7 @@ int output_format(const char *name)
     if (!strcmp(ext, "png")) return FORMAT_PNG;
     if (!strcmp(ext, "pfm")) return FORMAT_PFM;
     if (!strcmp(ext, "exr")) return FORMAT_EXR;
+    if (!strcmp(ext, "part")) return FORMAT_PART;
     for (i = 0; i < sizeof other / sizeof *other; i++)
         if (!strcmp(ext, other[i])) return FORMAT_OTHER;
     return FORMAT_PPM;
@@ -78,7 +80,7 @@ int float_format(int format) { return format == FORMAT_PFM || format == FORMAT_E
 
 const char *format_name(int format)
 {
-    static const char *const names[] = { "PPM", "PNG", "PFM", "OpenEXR" };
+    static const char *const names[] = { "PPM", "PNG", "PFM", "OpenEXR", "a partial render" };
     return format >= FORMAT_PPM && format < FORMAT_OTHER ? names[format] : "another format";
 }
 
@@ -1023,6 +1025,8 @@ static int replace_file(const char *from, const char *to)
     return rename(from, to);
 }
 
+static int close_output(Output *o, int ok);
+
 /* The image in the output's format, then the file closed and, if it was
  * written as a temporary, renamed into place; on failure a message and no
  * file.  A PNG of sRGB bytes says so. */
@@ -1037,6 +1041,13 @@ int write_image(Output *o, const Image *img, int plain)
         if (!ok) errno = ENOMEM;
     } else
         write_ppm(o->f, img->bytes, img->w, img->h, plain);
+    return close_output(o, ok);
+}
+
+/* The output's file closed and, if it was written as a temporary, renamed
+ * into place; on failure a message and no file. */
+static int close_output(Output *o, int ok)
+{
     ok = ok && fflush(o->f) == 0 && !ferror(o->f);
     if (o->f != stdout) ok = fclose(o->f) == 0 && ok;
     if (ok && o->tmp) ok = replace_file(o->tmp, o->name) == 0;
@@ -1048,4 +1059,401 @@ int write_image(Output *o, const Image *img, int plain)
     free(o->tmp);
     free(o->target);
     return ok;
+}
+
+/* ---------------------------------------------------- partial renders */
+
+/* v as an Exact number (image.h): its magnitude cut down to a multiple of
+ * 2^-64, then negated in two's complement if v is negative.  NaN adds
+ * nothing; beyond 9.2e18 is clamped, inside the sums' range. */
+static Exact exact_of(double v)
+{
+    Exact e = { 0, 0 };
+    double a = fabs(v), whole;
+    if (!(a > 0)) return e;
+    if (a > 9.2e18) a = 9.2e18;
+    whole = floor(a);
+    e.hi = (uint64_t)whole;
+    e.lo = (uint64_t)ldexp(a - whole, 64);  /* a - whole is exact, below 1 */
+    if (v < 0) {
+        e.hi = ~e.hi + (e.lo == 0);
+        e.lo = ~e.lo + 1;
+    }
+    return e;
+}
+
+void exact_sum(Exact *sum, const Exact *more)
+{
+    uint64_t lo = sum->lo + more->lo;       /* unsigned: wraps, and the carry shows */
+    sum->hi += more->hi + (lo < more->lo);
+    sum->lo = lo;
+}
+
+void exact_add(Exact *sum, double v)
+{
+    Exact e = exact_of(v);
+    exact_sum(sum, &e);
+}
+
+/* The sum as a double: the same rounding wherever it is computed. */
+double exact_value(const Exact *sum)
+{
+    Exact e = *sum;
+    if (e.hi >> 63) {                       /* negative: the value of its negation */
+        e.hi = ~e.hi + (e.lo == 0);
+        e.lo = ~e.lo + 1;
+        return -((double)e.hi + ldexp((double)e.lo, -64));
+    }
+    return (double)e.hi + ldexp((double)e.lo, -64);
+}
+
+static size_t partial_pixels(const Partial *p) { return (size_t)(p->x1 - p->x0) * (size_t)(p->y1 - p->y0); }
+
+int new_partial(Partial *p)
+{
+    size_t n = partial_pixels(p);
+    p->sum = calloc(3 * n, sizeof *p->sum);
+    p->n = calloc(n, sizeof *p->n);
+    if (p->sum && p->n) return 1;
+    free_partial(p);
+    return 0;
+}
+
+void free_partial(Partial *p)
+{
+    free(p->sum);
+    free(p->n);
+    p->sum = NULL;
+    p->n = NULL;
+}
+
+static void put_u64(unsigned char *p, uint64_t v)
+{
+    int i;
+    for (i = 0; i < 8; i++) p[i] = (unsigned char)(v >> 8 * i);
+}
+
+static uint64_t get_u64(const unsigned char *p)
+{
+    uint64_t v = 0;
+    int i;
+    for (i = 7; i >= 0; i--) v = v << 8 | p[i];
+    return v;
+}
+
+#define PIXEL_BYTES 56              /* n and three sums of two words: 7 x 8 bytes */
+
+/* The partial's file (image.h's format), rows as write_partial's. */
+static void put_partial(FILE *f, const Partial *p, const unsigned char *rows)
+{
+    int w = p->x1 - p->x0, x, y;
+    unsigned char px[PIXEL_BYTES];
+    static const unsigned char none[PIXEL_BYTES];
+    fprintf(f, "ray partial 1\nimage %d %d\ncrop %d %d %d %d\nsamples %d %d %d\npixels %s\n%send\n", p->w,
+            p->h, p->x0, p->y0, p->x1, p->y1, p->s0, p->s1, p->spp, p->srgb ? "srgb" : "linear", p->about);
+    for (y = 0; y < p->y1 - p->y0; y++)
+        for (x = 0; x < w; x++) {
+            size_t at = (size_t)y * w + x;
+            int c;
+            if (rows && !rows[y]) { fwrite(none, 1, sizeof none, f); continue; }
+            put_u64(px, p->n[at]);
+            for (c = 0; c < 3; c++) {
+                put_u64(px + 8 + 16 * c, p->sum[3 * at + c].hi);
+                put_u64(px + 16 + 16 * c, p->sum[3 * at + c].lo);
+            }
+            fwrite(px, 1, sizeof px, f);
+        }
+}
+
+int write_partial(Output *o, const Partial *p, const unsigned char *rows)
+{
+    errno = 0;
+    put_partial(o->f, p, rows);
+    return close_output(o, 1);
+}
+
+int save_partial(const char *name, const Partial *p, const unsigned char *rows)
+{
+    char *tmp = NULL;
+    FILE *f = create_temp(name, &tmp);
+    int ok = f != NULL;
+    errno = 0;
+    if (f) {
+        put_partial(f, p, rows);
+        ok = fflush(f) == 0 && !ferror(f);
+        ok = fclose(f) == 0 && ok;
+        ok = ok && replace_file(tmp, name) == 0;
+    }
+    if (!ok) {
+        fprintf(stderr, "%s: cannot write the checkpoint: %s\n", name, strerror(errno));
+        if (tmp) remove(tmp);
+    }
+    free(tmp);
+    return ok;
+}
+
+/* One line of a partial's header into line (its end cut); 0 at the end of
+ * the file or when it is too long. */
+static int header_line(FILE *f, char *line, int size)
+{
+    size_t n;
+    if (!fgets(line, size, f)) return 0;
+    n = strlen(line);
+    if (n == 0 || line[n - 1] != '\n') return 0;
+    line[n - 1] = 0;
+    return 1;
+}
+
+static int partial_fails(const char *name, int line, const char *what)
+{
+    if (line) fprintf(stderr, "%s:%d: %s\n", name, line, what);
+    else fprintf(stderr, "%s: %s\n", name, what);
+    return 0;
+}
+
+/* The header's numbers, each line as its format says; 0 after a message. */
+static int read_header(FILE *f, const char *name, Partial *p)
+{
+    char line[PARTIAL_ABOUT], word[16], extra;
+    int at;
+    size_t used = 0;
+    if (!header_line(f, line, sizeof line) || strcmp(line, "ray partial 1"))
+        return partial_fails(name, 1, "not a partial render of ray (its first line is not `ray partial 1`)");
+    if (!header_line(f, line, sizeof line) || sscanf(line, "image %d %d %c", &p->w, &p->h, &extra) != 2
+        || p->w < 1 || p->h < 1 || p->w > 32768 || p->h > 32768)
+        return partial_fails(name, 2, "needs `image W H`, from 1 to 32768");
+    if (!header_line(f, line, sizeof line)
+        || sscanf(line, "crop %d %d %d %d %c", &p->x0, &p->y0, &p->x1, &p->y1, &extra) != 4 || p->x0 < 0
+        || p->y0 < 0 || p->x1 <= p->x0 || p->y1 <= p->y0 || p->x1 > p->w || p->y1 > p->h)
+        return partial_fails(name, 3, "needs `crop X0 Y0 X1 Y1`, a rectangle of the image");
+    if (!header_line(f, line, sizeof line)
+        || sscanf(line, "samples %d %d %d %c", &p->s0, &p->s1, &p->spp, &extra) != 3 || p->s0 < 0
+        || p->s1 <= p->s0 || p->s1 > p->spp)
+        return partial_fails(name, 4, "needs `samples S0 S1 SPP`, with 0 <= S0 < S1 <= SPP");
+    if (!header_line(f, line, sizeof line) || sscanf(line, "pixels %15s %c", word, &extra) != 1
+        || (strcmp(word, "srgb") && strcmp(word, "linear")))
+        return partial_fails(name, 5, "needs `pixels srgb` or `pixels linear`");
+    p->srgb = !strcmp(word, "srgb");
+    for (at = 6; header_line(f, line, sizeof line) && strcmp(line, "end"); at++) {
+        if (used + strlen(line) + 2 > sizeof p->about)
+            return partial_fails(name, at, "the provenance is longer than a partial's may be");
+        memcpy(p->about + used, line, strlen(line));
+        used += strlen(line);
+        p->about[used++] = '\n';
+    }
+    if (feof(f) || ferror(f)) return partial_fails(name, at, "the header has no `end` line");
+    p->about[used] = 0;
+    return 1;
+}
+
+/* Are the bytes left in f those of n pixels?  f stays where it is. */
+static int holds_pixels(FILE *f, size_t n)
+{
+    long here = ftell(f), end;
+    if (here < 0 || fseek(f, 0, SEEK_END) != 0) return 1;     /* a pipe: the reads will tell */
+    end = ftell(f);
+    if (fseek(f, here, SEEK_SET) != 0) return 0;
+    return end >= here && (double)(end - here) == (double)n * PIXEL_BYTES;
+}
+
+int read_partial(const char *name, Partial *p)
+{
+    FILE *f = fopen(name, "rb");
+    unsigned char px[PIXEL_BYTES];
+    size_t at, n;
+    int ok;
+    memset(p, 0, sizeof *p);
+    if (!f) return partial_fails(name, 0, strerror(errno));
+    ok = read_header(f, name, p);
+    if (ok && !holds_pixels(f, partial_pixels(p)))     /* before the memory for them is taken */
+        ok = partial_fails(name, 0, "truncated, or too long: not the bytes its crop's pixels take");
+    if (ok && !new_partial(p)) ok = partial_fails(name, 0, "out of memory");
+    n = ok ? partial_pixels(p) : 0;
+    for (at = 0; ok && at < n; at++) {
+        int c;
+        if (fread(px, 1, sizeof px, f) != sizeof px) {
+            ok = partial_fails(name, 0, "truncated: fewer pixels than its crop holds");
+            break;
+        }
+        p->n[at] = get_u64(px);
+        if (p->n[at] > (uint64_t)(p->s1 - p->s0)) ok = partial_fails(name, 0, "a pixel holds more samples than its range");
+        for (c = 0; c < 3; c++) {
+            p->sum[3 * at + c].hi = get_u64(px + 8 + 16 * c);
+            p->sum[3 * at + c].lo = get_u64(px + 16 + 16 * c);
+        }
+    }
+    if (ok && getc(f) != EOF) ok = partial_fails(name, 0, "more bytes than its crop holds");
+    fclose(f);
+    if (!ok) free_partial(p);
+    return ok;
+}
+
+/* The first line in which two provenances differ, into what: "KEY: A, not B". */
+static void first_difference(const char *a, const char *b, char *what, size_t size)
+{
+    while (*a && *b) {
+        size_t la = strcspn(a, "\n"), lb = strcspn(b, "\n");
+        if (la != lb || memcmp(a, b, la)) break;
+        a += la + (a[la] != 0);
+        b += lb + (b[lb] != 0);
+    }
+    snprintf(what, size, "`%.*s`, not `%.*s`", (int)strcspn(b, "\n"), b, (int)strcspn(a, "\n"), a);
+}
+
+/* Do parts a and b hold a sample of the same pixel? */
+static int overlap(const Partial *a, const Partial *b)
+{
+    return a->x0 < b->x1 && b->x0 < a->x1 && a->y0 < b->y1 && b->y0 < a->y1 && a->s0 < b->s1 && b->s0 < a->s1;
+}
+
+/* The first samples that no part holds of pixel (x, y), into *lo .. *hi. */
+static void gap(const Partial *parts, int n, int x, int y, int *lo, int *hi)
+{
+    int k = 0, i, moved = 1;
+    while (moved) {
+        moved = 0;
+        for (i = 0; i < n; i++) {
+            const Partial *p = &parts[i];
+            if (x >= p->x0 && x < p->x1 && y >= p->y0 && y < p->y1 && p->s0 <= k && k < p->s1
+                && p->n[(size_t)(y - p->y0) * (p->x1 - p->x0) + (x - p->x0)])
+                k = p->s1, moved = 1;
+        }
+    }
+    *lo = k;
+    *hi = parts[0].spp;
+    for (i = 0; i < n; i++)
+        if (x >= parts[i].x0 && x < parts[i].x1 && y >= parts[i].y0 && y < parts[i].y1 && parts[i].s0 > k
+            && parts[i].s0 < *hi)
+            *hi = parts[i].s0;
+}
+
+/* Each pixel's samples counted over the parts; a hole is said: how many
+ * pixels lack samples, where, and which samples the first lacks. */
+static int no_holes(const Partial *parts, int n, const Partial *whole)
+{
+    uint64_t *covered = calloc((size_t)whole->w * whole->h, sizeof *covered), missing = 0;
+    int i, x, y, fx = 0, fy = 0, x0 = whole->w, y0 = whole->h, x1 = 0, y1 = 0, lo, hi;
+    if (!covered) return partial_fails("ray", 0, "out of memory");
+    for (i = 0; i < n; i++)
+        for (y = parts[i].y0; y < parts[i].y1; y++)
+            for (x = parts[i].x0; x < parts[i].x1; x++)
+                if (parts[i].n[(size_t)(y - parts[i].y0) * (parts[i].x1 - parts[i].x0) + (x - parts[i].x0)])
+                    covered[(size_t)y * whole->w + x] += (uint64_t)(parts[i].s1 - parts[i].s0);
+    for (y = 0; y < whole->h; y++)
+        for (x = 0; x < whole->w; x++)
+            if (covered[(size_t)y * whole->w + x] != (uint64_t)whole->spp) {
+                if (!missing++) fx = x, fy = y;
+                if (x < x0) x0 = x;
+                if (y < y0) y0 = y;
+                if (x >= x1) x1 = x + 1;
+                if (y >= y1) y1 = y + 1;
+            }
+    free(covered);
+    if (!missing) return 1;
+    gap(parts, n, fx, fy, &lo, &hi);
+    fprintf(stderr, "ray: the parts leave a hole: %llu pixels lack samples, within crop %d,%d,%d,%d;"
+            " the first, (%d, %d), lacks samples %d:%d of %d\n", (unsigned long long)missing, x0, y0, x1, y1,
+            fx, fy, lo, hi, whole->spp);
+    return 0;
+}
+
+/* Were a (file an) and b made by one render (image, samples, pixels'
+ * curve, provenance)?  Else a message that names what differs, and 0. */
+static int belongs(const Partial *a, const char *an, const Partial *b, const char *bn)
+{
+    char what[2 * PARTIAL_ABOUT];
+    if (a->w != b->w || a->h != b->h || a->spp != b->spp || a->srgb != b->srgb) {
+        fprintf(stderr, "ray: %s is not a part of the render %s is: image %dx%d of %d samples%s, not %dx%d"
+                " of %d%s\n", bn, an, b->w, b->h, b->spp, b->srgb ? " (sRGB)" : "", a->w, a->h, a->spp,
+                a->srgb ? " (sRGB)" : "");
+        return 0;
+    }
+    if (strcmp(a->about, b->about)) {
+        first_difference(a->about, b->about, what, sizeof what);
+        fprintf(stderr, "ray: %s is not a part of the render %s is: %s\n", bn, an, what);
+        return 0;
+    }
+    return 1;
+}
+
+int same_part(const Partial *got, const Partial *want, const char *name)
+{
+    if (!belongs(want, "this run", got, name)) return 0;
+    if (got->x0 != want->x0 || got->y0 != want->y0 || got->x1 != want->x1 || got->y1 != want->y1
+        || got->s0 != want->s0 || got->s1 != want->s1) {
+        fprintf(stderr, "ray: %s holds crop %d,%d,%d,%d and samples %d:%d; this run renders crop %d,%d,%d,%d"
+                " and samples %d:%d\n", name, got->x0, got->y0, got->x1, got->y1, got->s0, got->s1, want->x0,
+                want->y0, want->x1, want->y1, want->s0, want->s1);
+        return 0;
+    }
+    return 1;
+}
+
+int merge_partials(Partial *parts, const char *const *names, int n, Partial *whole)
+{
+    int i, k;
+    for (i = 1; i < n; i++)
+        if (!belongs(&parts[0], names[0], &parts[i], names[i])) return 0;
+    for (i = 0; i < n; i++)
+        for (k = i + 1; k < n; k++)
+            if (overlap(&parts[i], &parts[k])) {
+                const Partial *a = &parts[i], *b = &parts[k];
+                fprintf(stderr, "ray: %s and %s overlap: both hold samples %d:%d of the pixels in crop"
+                        " %d,%d,%d,%d\n", names[i], names[k], a->s0 > b->s0 ? a->s0 : b->s0,
+                        a->s1 < b->s1 ? a->s1 : b->s1, a->x0 > b->x0 ? a->x0 : b->x0, a->y0 > b->y0 ? a->y0 : b->y0,
+                        a->x1 < b->x1 ? a->x1 : b->x1, a->y1 < b->y1 ? a->y1 : b->y1);
+                return 0;
+            }
+    *whole = parts[0];
+    whole->x0 = whole->y0 = whole->s0 = 0;
+    whole->x1 = whole->w;
+    whole->y1 = whole->h;
+    whole->s1 = whole->spp;
+    if (!new_partial(whole)) return partial_fails("ray", 0, "out of memory for the merged image");
+    if (!no_holes(parts, n, whole)) { free_partial(whole); return 0; }
+    for (i = 0; i < n; i++) {           /* integers: the order does not matter */
+        const Partial *p = &parts[i];
+        int x, y, c;
+        for (y = p->y0; y < p->y1; y++)
+            for (x = p->x0; x < p->x1; x++) {
+                size_t from = (size_t)(y - p->y0) * (p->x1 - p->x0) + (x - p->x0), to = (size_t)y * whole->w + x;
+                whole->n[to] += p->n[from];
+                for (c = 0; c < 3; c++) exact_sum(&whole->sum[3 * to + c], &p->sum[3 * from + c]);
+            }
+    }
+    return 1;
+}
+
+/* ------------------------------------------------ stop signals (checkpoints) */
+
+/* The signal that asked a render with checkpoints to stop, or 0: the
+ * second global of the signal handlers'. */
+static volatile sig_atomic_t stop_by;
+
+/* The first stop signal is remembered (the render then saves its work);
+ * a second ends the program at once, as without checkpoints. */
+static void on_stop(int sig)
+{
+    if (stop_by) on_signal(sig);
+    stop_by = sig;
+}
+
+void catch_stop_signals(void)
+{
+    static const int sigs[] = { SIGINT, SIGTERM
+#ifdef RAY_POSIX
+        , SIGHUP
+#endif
+    };
+    size_t i;
+    for (i = 0; i < sizeof sigs / sizeof *sigs; i++)
+        if (!ignored(sigs[i])) signal(sigs[i], on_stop);
+}
+
+int stop_signal(void) { return (int)stop_by; }
+
+void end_by_signal(int sig)
+{
+    signal(sig, SIG_DFL);
+    raise(sig);
 }

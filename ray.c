@@ -244,6 +244,9 @@ typedef struct {
     int srgb;                 /* the bytes go through the sRGB curve (for adaptive's rule) */
     int no_skip;              /* --no-skip: no work skipped that the plain algorithm does */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
+    int x0, y0, x1, y1;       /* the pixels rendered, x0 <= x < x1, y0 <= y < y1: the whole
+                               * image, or a part of it (--crop, --tile) */
+    int s0;                   /* the first sample rendered of each pixel (--samples A:B: A) */
     const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
 } Settings;
 
@@ -355,7 +358,10 @@ typedef struct {
  * which costs cache hits but never changes an answer), and where the path
  * tracer's random numbers stand. */
 #define SHADOW_SLOTS 8
-#define RAY_BUDGET 1024         /* reflected and refracted rays a primary ray may spawn */
+#define RAY_BUDGET 1024
+/* A pixel's samples so far: their sum (exact, see tally()), the sum of
+ * their squares (for --adaptive's error estimate), and how many. */
+typedef struct Tally { Exact sum[3]; vec sq; int n; } Tally;         /* reflected and refracted rays a primary ray may spawn */
 typedef struct {
     Counts count;
     int blocker[SHADOW_SLOTS];  /* light i's last blocker, or -1, in slot i % SHADOW_SLOTS */
@@ -365,7 +371,9 @@ typedef struct {
     const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
     long long *splat;           /* this thread's splat image (see splat()), or NULL */
     int taken;                  /* samples the last pixel took (--view samples) */
-    const struct Tally *first;  /* Whitted's --adaptive: every pixel's first 4 samples, or NULL */
+    const Tally *first;         /* Whitted's --adaptive: every pixel's first 4 samples, or NULL */
+    Tally last;                 /* the last pixel's samples (for a partial render) */
+    Partial *part;              /* a partial render's sums (image.h), or NULL */
 } Worker;
 
 /* Two hooks in render() for the integrators still to come.  prepass runs
@@ -434,10 +442,11 @@ static void box_union(double lo[3], double hi[3], const double lo2[3], const dou
 /* for each pixel */
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk);
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk);
-typedef struct Tally { vec sum, sq; int n; } Tally;
 static const Tally *take_samples(const Scene *s, int i, int j, Tally *t, int n, Worker *wk);
 static int neighbours_agree(const Scene *s, const Tally *first, int i, int j);
 static void tally(Tally *t, vec c);
+static vec tally_sum(const Tally *t);
+static vec tally_mean(const Tally *t);
 static int pixel_done(const Scene *s, const Tally *t, int first);
 static int settled(const Scene *s, const Tally *t);
 static real srgb_slope(real v);
@@ -446,6 +455,7 @@ static void put_pixel(Image *img, int i, int j, vec c);
 static real srgb(real v);
 static unsigned char to_byte(real v);
 static vec pixel_view(const Scene *s, int i, int j, Worker *wk);   /* --view, in the plumbing */
+static void keep_sums(Partial *part, int i, int j, const Tally *t); /* a partial render: the plumbing */
 
 /* samples: the points of a pixel, random numbers, the warps and their pdfs */
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
@@ -584,12 +594,13 @@ static vec spherical_triangle_sample(const vec c[3], const real angle[3], real a
 static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 {
     int i;
-    for (i = 0; i < s->set.w; i++) {
+    for (i = s->set.x0; i < s->set.x1; i++) {     /* the whole row, or a split render's part */
         vec c = s->set.view && s->set.view != VIEW_SAMPLES ? pixel_view(s, i, j, wk)  /* --view: the plumbing */
                 : s->set.integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
                 : pixel_color(s, i, j, spp, wk);
         if (s->set.view == VIEW_SAMPLES) c = scale((real)wk->taken / spp, v3(1, 1, 1));
-        put_pixel(img, i, j, c);
+        if (img) put_pixel(img, i - s->set.x0, j - s->set.y0, c);
+        if (wk->part) keep_sums(wk->part, i, j, &wk->last);     /* a partial render: the plumbing */
     }
 }
 
@@ -597,7 +608,8 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
  * --adaptive, of those it takes: see pixel_done and neighbours_agree). */
 static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
 {
-    Tally t = { { 0, 0, 0 }, { 0, 0, 0 }, 0 };
+    Tally t;
+    memset(&t, 0, sizeof t);
     if (wk->first) {                        /* --adaptive: the first 4 were taken before */
         t = wk->first[(size_t)j * s->set.w + i];
         if (neighbours_agree(s, wk->first, i, j)) return pixel_mean(&t, wk);
@@ -606,12 +618,13 @@ static vec pixel_color(const Scene *s, int i, int j, int spp, Worker *wk)
 }
 
 /* Samples t->n, t->n + 1, ... of the pixel into t, up to n in all or
- * until pixel_done says it may stop (rounds from 8 on). */
+ * until pixel_done says it may stop (rounds from 8 on); counted from the
+ * first of a split render's range (--samples A:B: A). */
 static const Tally *take_samples(const Scene *s, int i, int j, Tally *t, int n, Worker *wk)
 {
     real shift = s->moving ? time_shift(wk, s, i, j) : 0;   /* no motion: no numbers drawn */
     int k;
-    for (k = t->n; k < n && !pixel_done(s, t, 8); k++) {
+    for (k = s->set.s0 + t->n; k < s->set.s0 + n && !pixel_done(s, t, 8); k++) {
         real dx, dy;
         Ray r;
         sample_offset(k, s->cam.anchor, &dx, &dy);
@@ -650,10 +663,19 @@ static const Tally *take_samples(const Scene *s, int i, int j, Tally *t, int n, 
  * that the image's error stops falling as -n grows. */
 static void tally(Tally *t, vec c)
 {
-    t->sum = add(t->sum, c);
+    exact_add(&t->sum[0], (double)c.x);     /* added exactly: a render split over */
+    exact_add(&t->sum[1], (double)c.y);     /* machines merges to the same bytes, */
+    exact_add(&t->sum[2], (double)c.z);     /* whatever order its parts add in (image.h) */
     t->sq = add(t->sq, mul(c, c));
     t->n++;
 }
+
+static vec tally_sum(const Tally *t)
+{
+    return v3((real)exact_value(&t->sum[0]), (real)exact_value(&t->sum[1]), (real)exact_value(&t->sum[2]));
+}
+
+static vec tally_mean(const Tally *t) { return scale((real)1 / t->n, tally_sum(t)); }
 
 /* Whether the pixel stops now, after t->n samples: only with --adaptive,
  * only at a round's end (first, 2 first, 4 first, ...; first a power of
@@ -667,7 +689,7 @@ static int settled(const Scene *s, const Tally *t)
 {
     double sum[3], sq[3];
     int c;
-    to3(t->sum, sum);
+    to3(tally_sum(t), sum);
     to3(t->sq, sq);
     for (c = 0; c < 3; c++) {
         double mean = sum[c] / t->n, var = fmax(0, (sq[c] - sum[c] * mean) / (t->n - 1));
@@ -697,8 +719,8 @@ static int neighbours_agree(const Scene *s, const Tally *first, int i, int j)
             if (a < 0 || b < 0 || a >= s->set.w || b >= s->set.h || (di == 0 && dj == 0)) continue;
             u = &first[(size_t)b * s->set.w + a];
             if (!settled(s, u)) return 0;
-            to3(scale((real)1 / t->n, t->sum), m);
-            to3(scale((real)1 / u->n, u->sum), q);
+            to3(scale((real)1 / t->n, tally_sum(t)), m);
+            to3(scale((real)1 / u->n, tally_sum(u)), q);
             for (c = 0; c < 3; c++)
                 if (fmin(m[c], q[c]) < 1
                     && fabs(m[c] - q[c]) * (s->set.srgb ? srgb_slope((real)fmin(m[c], q[c])) : 1) > s->set.adaptive / 255)
@@ -719,10 +741,11 @@ static real srgb_slope(real v)
 static vec pixel_mean(const Tally *t, Worker *wk)
 {
     wk->taken = t->n;
+    wk->last = *t;
     wk->count.samples += (unsigned)t->n;
     if (!wk->count.spp_max || t->n < wk->count.spp_min) wk->count.spp_min = t->n;
     if (t->n > wk->count.spp_max) wk->count.spp_max = t->n;
-    return scale((real)1 / t->n, t->sum);
+    return tally_mean(t);
 }
 
 /* The pixel into the image: as floats (for PFM and EXR, the radiance itself), or
@@ -1447,10 +1470,11 @@ enum { DIFFUSE_LOBE, GLOSSY_LOBE, MIRROR_LOBE, GGX_LOBE, GLASS_LOBE, LOBE_KINDS 
  * and left out, so that no NaN reaches an image. */
 static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk)
 {
-    Tally t = { { 0, 0, 0 }, { 0, 0, 0 }, 0 };
+    Tally t;
     vec L;
     int k;
-    for (k = 0; k < spp && !pixel_done(s, &t, 16); k++) {     /* --adaptive: see pixel_done */
+    memset(&t, 0, sizeof t);
+    for (k = s->set.s0; k < s->set.s0 + spp && !pixel_done(s, &t, 16); k++) {     /* --adaptive: see pixel_done */
         L = sample_radiance(s, i, j, k, wk);
         if (!(isfinite(L.x) && isfinite(L.y) && isfinite(L.z))) {
             wk->count.discarded++;
@@ -3036,9 +3060,13 @@ static int degenerate(vec a, vec b, vec c)
 /* ------------------------------------------------ threads, render()'s hooks */
 
 typedef struct {
-    int spp, threads, progress;
+    int spp, threads, progress;   /* spp: each pixel's samples, of a split render's part too */
     double start;                 /* when the render began (now()), for the progress line */
     const Hooks *hooks;           /* NULL: none */
+    Partial *part;                /* a partial render's sums, or NULL (see keep_sums) */
+    unsigned char *done;          /* with part: the rows done (row y0 + r: done[r]), */
+    const char *checkpoint;       /* where they are saved, */
+    double every;                 /* every so many seconds (0: never) */
 } Options;
 
 static void add_counts(Counts *to, const Counts *from)
@@ -3119,9 +3147,12 @@ static void add_splats(const Scene *s, const Options *o, long long **splats, int
 }
 
 /* Whitted's --adaptive: every pixel's first 4 samples, taken before the
- * rest (see neighbours_agree), on every thread; NULL when not needed. */
+ * rest (see neighbours_agree), on every thread; NULL when not needed.  For
+ * a part of the image, those of its pixels and their neighbours. */
 static Tally *first_samples(const Scene *s, const Options *o, int nthreads, Counts *total)
 {
+    int x0 = s->set.x0 > 0 ? s->set.x0 - 1 : 0, x1 = s->set.x1 < s->set.w ? s->set.x1 + 1 : s->set.w;
+    int y0 = s->set.y0 > 0 ? s->set.y0 - 1 : 0, y1 = s->set.y1 < s->set.h ? s->set.y1 + 1 : s->set.h;
     Tally *first;
     (void)nthreads;                     /* without OpenMP: one */
     if (!(s->set.adaptive > 0) || s->set.integrator != WHITTED || o->hooks || o->spp <= 4
@@ -3134,10 +3165,10 @@ static Tally *first_samples(const Scene *s, const Options *o, int nthreads, Coun
         int j;
         memset(&wk, 0, sizeof wk);
         OMP(omp for schedule(dynamic, 1))
-        for (j = 0; j < s->set.h; j++) {
+        for (j = y0; j < y1; j++) {
             int i;
             for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
-            for (i = 0; i < s->set.w; i++) {
+            for (i = x0; i < x1; i++) {
                 Tally *t = &first[(size_t)j * s->set.w + i];
                 memset(t, 0, sizeof *t);
                 take_samples(s, i, j, t, 4, &wk);
@@ -3157,10 +3188,14 @@ static Tally *first_samples(const Scene *s, const Options *o, int nthreads, Coun
  * added to the pixels at the end (add_splats). */
 static void render(const Scene *s, const Options *o, Image *img, Counts *total)
 {
-    int done = 0, stride = row_stride(s->set.h), nthreads = 1, splats = o->hooks && o->hooks->after_sample;
+    int k;
+    int rows = s->set.y1 - s->set.y0, done = 0, stride = row_stride(rows), nthreads = 1;
+    int splats = o->hooks && o->hooks->after_sample;
     long long **splat = NULL;
     Tally *first;
-    Image own = *img;
+    Image own, *into = img;
+    double saved = now();
+    for (k = 0; o->done && k < rows; k++) done += o->done[k];     /* --resume: rows done before */
 #ifdef _OPENMP
     if (o->threads > 0) omp_set_num_threads(o->threads);
     nthreads = o->threads > 0 ? o->threads : omp_get_max_threads();
@@ -3171,17 +3206,18 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         int t;
         splat = calloc((size_t)nthreads, sizeof *splat);
         if (!splat || !new_image(&own, s->set.w, s->set.h, 1, 0)) out_of_memory();
+        into = &own;
         for (t = 0; t < nthreads; t++)
             if (!(splat[t] = calloc((size_t)s->set.w * s->set.h * 3, sizeof **splat))) out_of_memory();
     }
     OMP(omp parallel num_threads(nthreads))
     {
         Worker wk;
-        int k;
         memset(&wk, 0, sizeof wk);
         wk.count.threads = 1;
         wk.hooks = o->hooks;
         wk.first = first;
+        wk.part = o->part;
 #ifdef _OPENMP
         wk.count.threads = omp_get_num_threads();
         if (splats) wk.splat = splat[omp_get_thread_num()];
@@ -3189,16 +3225,27 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         if (splats) wk.splat = splat[0];
 #endif
         OMP(omp for schedule(dynamic, 1))
-        for (k = 0; k < s->set.h; k++) {
-            int i, mine;
+        for (k = 0; k < rows; k++) {
+            int i, mine, r = (int)((long long)k * stride % rows);
+            if ((o->done && o->done[r]) || stop_signal()) continue;   /* resumed; or asked to stop */
             /* a row starts with an empty shadow cache, so that the counts
              * do not depend on which thread had the row before */
             for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
-            render_row(s, (int)((long long)k * stride % s->set.h), o->spp, &own, &wk);
+            render_row(s, s->set.y0 + r, o->spp, into, &wk);
+            if (o->done) {
+                OMP(omp critical)
+                {
+                    o->done[r] = 1;             /* whole: the next checkpoint saves it */
+                    if (o->every > 0 && now() - saved >= o->every) {
+                        save_partial(o->checkpoint, o->part, o->done);
+                        saved = now();
+                    }
+                }
+            }
             OMP(omp atomic capture)
             mine = ++done;
-            if (o->progress && (mine * 100 / s->set.h != (mine - 1) * 100 / s->set.h))
-                show_progress(o->start, mine, s->set.h);
+            if (o->progress && (mine * 100 / rows != (mine - 1) * 100 / rows))
+                show_progress(o->start, mine, rows);
         }
         OMP(omp critical)
         add_counts(total, &wk.count);
@@ -3212,6 +3259,98 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
     }
     free(first);
     if (o->progress) fprintf(stderr, "\r%30s\r", "");
+}
+
+/* --------------------------------------------------------- partial renders */
+
+/* A render split over machines (--crop, --tile, --samples; image.h): each
+ * pixel's sums and count kept as they are, for ray --merge to add. */
+static void keep_sums(Partial *part, int i, int j, const Tally *t)
+{
+    size_t at = (size_t)(j - part->y0) * (part->x1 - part->x0) + (i - part->x0);
+    memcpy(&part->sum[3 * at], t->sum, sizeof t->sum);
+    part->n[at] = (uint64_t)t->n;
+}
+
+/* The partial's pixels into img, each the mean of its samples, as the
+ * render computes it (tally_mean): so a merge gives a whole run's bytes. */
+static void image_of(const Partial *part, Image *img)
+{
+    int x, y;
+    for (y = part->y0; y < part->y1; y++)
+        for (x = part->x0; x < part->x1; x++) {
+            size_t at = (size_t)(y - part->y0) * (part->x1 - part->x0) + (x - part->x0);
+            Tally t;
+            memcpy(t.sum, &part->sum[3 * at], sizeof t.sum);
+            t.n = (int)part->n[at];
+            put_pixel(img, x - part->x0, y - part->y0, t.n ? tally_mean(&t) : v3(0, 0, 0));
+        }
+}
+
+/* FNV-1a, 64 bits, over n bytes: the scene's content hash. */
+static uint64_t fold(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    while (n--) h = (h ^ *b++) * 1099511628211u;
+    return h;
+}
+#define FOLD(h, x) ((h) = fold((h), &(x), sizeof(x)))
+
+/* What the scene holds, as read (objects, materials, lights, camera,
+ * background): a partial render's provenance names it, so that parts of
+ * two scenes, or of one scene edited between them, are not merged.  Field
+ * by field, not whole structures, whose padding holds any bytes. */
+static uint64_t scene_hash(const Scene *s)
+{
+    uint64_t h = 14695981039346656037u;
+    int i;
+    for (i = 0; i < s->nmat; i++) {
+        const Material *m = &s->mat[i];
+        FOLD(h, m->color); FOLD(h, m->kd); FOLD(h, m->ks); FOLD(h, m->kt); FOLD(h, m->kl);
+        FOLD(h, m->ir); FOLD(h, m->shine); FOLD(h, m->rough); FOLD(h, m->spread);
+    }
+    for (i = 0; i < s->nsph; i++) {
+        const Sphere *b = &s->sph[i];
+        FOLD(h, b->cen); FOLD(h, b->rad); FOLD(h, b->mat); FOLD(h, b->move);
+    }
+    for (i = 0; i < s->ncone; i++) {
+        const Cone *c = &s->cone[i];
+        FOLD(h, c->base); FOLD(h, c->axis); FOLD(h, c->len); FOLD(h, c->rb); FOLD(h, c->ra);
+        FOLD(h, c->mat); FOLD(h, c->move);
+    }
+    for (i = 0; i < s->ntri; i++) {
+        const Triangle *t = &s->tri[i];
+        FOLD(h, t->v); FOLD(h, t->n); FOLD(h, t->mat); FOLD(h, t->move); FOLD(h, t->cull);
+    }
+    if (s->nvert) h = fold(h, s->vert, (size_t)s->nvert * sizeof *s->vert);
+    if (s->nnorm) h = fold(h, s->norm, (size_t)s->nnorm * sizeof *s->norm);
+    for (i = 0; i < s->nlight; i++) {
+        FOLD(h, s->light[i].pos); FOLD(h, s->light[i].color); FOLD(h, s->light[i].sphere);
+    }
+    FOLD(h, s->cam.eye); FOLD(h, s->cam.right); FOLD(h, s->cam.up); FOLD(h, s->cam.fwd);
+    FOLD(h, s->cam.tan_half); FOLD(h, s->cam.anchor); FOLD(h, s->cam.hither);
+    FOLD(h, s->cam.hither_sphere); FOLD(h, s->cam.lens); FOLD(h, s->cam.focus);
+    FOLD(h, s->ambient); FOLD(h, s->background); FOLD(h, s->tir_reflect); FOLD(h, s->lights_centre);
+    FOLD(h, s->shadow_rays); FOLD(h, s->shutter);
+    return h;
+}
+
+/* A partial render of this run: its part of the image and of the
+ * samples, and its provenance, every choice that changes a pixel.  With
+ * the pixels' sums all 0. */
+static int start_partial(const Scene *s, const Options *o, int spp, Partial *p)
+{
+    memset(p, 0, sizeof *p);
+    p->w = s->set.w, p->h = s->set.h, p->spp = spp;
+    p->x0 = s->set.x0, p->y0 = s->set.y0, p->x1 = s->set.x1, p->y1 = s->set.y1;
+    p->s0 = s->set.s0, p->s1 = s->set.s0 + o->spp;
+    p->srgb = s->set.srgb;
+    sprintf(p->about, "version %s\nscene %016llx\nrenderer %s\ndepth %d\nmax_rays %d\nestimator %d\n"
+            "roulette %d\nseed %u\nadaptive %.17g\nno_skip %d\n", program_version(),
+            (unsigned long long)scene_hash(s), s->set.integrator == PATH ? "path" : "whitted", s->set.depth,
+            s->set.max_rays, s->set.estimator, s->set.roulette, s->set.seed, (double)s->set.adaptive,
+            s->set.no_skip);
+    return new_partial(p);
 }
 
 /* ------------------------------------------------------------------ --view */
@@ -3648,8 +3787,114 @@ static int settle_path_options(Scene *s, int integrator, int estimator, int roul
     return 1;
 }
 
+/* A render of every pixel and every sample (the default, which the
+ * split options below narrow). */
+static void whole_image(Scene *s)
+{
+    s->set.x0 = s->set.y0 = s->set.s0 = 0;
+    s->set.x1 = s->set.w, s->set.y1 = s->set.h;
+}
+
+/* The part of the image and of the samples this run renders (--crop,
+ * --tile, --samples) onto the scene, and *count, each pixel's samples in
+ * it; 0 with a message when it does not fit the image or -n's spp. */
+static int settle_split(Scene *s, const Args *a, int spp, int *count)
+{
+    int w = s->set.w, h = s->set.h;
+    whole_image(s);
+    *count = spp;
+    if (a->cropped && (a->crop[2] > w || a->crop[3] > h)) {
+        fprintf(stderr, "ray: --crop %d,%d,%d,%d reaches beyond the %dx%d image\n", a->crop[0], a->crop[1],
+                a->crop[2], a->crop[3], w, h);
+        return 0;
+    }
+    if (a->cropped) s->set.x0 = a->crop[0], s->set.y0 = a->crop[1], s->set.x1 = a->crop[2], s->set.y1 = a->crop[3];
+    if (a->tiles > h) {
+        fprintf(stderr, "ray: --tile %d/%d: the image has %d rows, too few for %d bands\n", a->tile, a->tiles, h,
+                a->tiles);
+        return 0;
+    }
+    if (a->tiles) {
+        s->set.y0 = (int)((long long)a->tile * h / a->tiles);
+        s->set.y1 = (int)((long long)(a->tile + 1) * h / a->tiles);
+    }
+    if (a->samples[1] > spp) {
+        fprintf(stderr, "ray: --samples %d:%d reaches beyond the %d samples a pixel has (-n)\n", a->samples[0],
+                a->samples[1], spp);
+        return 0;
+    }
+    if (a->samples[0] > 0 && s->set.adaptive > 0) {
+        fprintf(stderr, "ray: --samples %d:%d with --adaptive: whether a pixel takes more samples is decided by"
+                " those before, so a range must start at 0\n", a->samples[0], a->samples[1]);
+        return 0;
+    }
+    if (a->samples[1]) s->set.s0 = a->samples[0], *count = a->samples[1] - a->samples[0];
+    return 1;
+}
+
+/* --resume: the rows of the checkpoint in file that are done, into part
+ * and done; 0 after a message when it is no checkpoint of this render. */
+static int resume_from(const char *file, Partial *part, unsigned char *done)
+{
+    Partial old;
+    int r, x, w = part->x1 - part->x0;
+    if (!read_partial(file, &old)) return 0;
+    if (!same_part(&old, part, file)) {
+        free_partial(&old);
+        return 0;
+    }
+    for (r = 0; r < part->y1 - part->y0; r++) {
+        size_t at = (size_t)r * w;
+        for (x = 0, done[r] = 1; x < w; x++) done[r] &= old.n[at + x] > 0;
+        if (!done[r]) continue;
+        memcpy(&part->sum[3 * at], &old.sum[3 * at], 3 * (size_t)w * sizeof *part->sum);
+        memcpy(&part->n[at], &old.n[at], (size_t)w * sizeof *part->n);
+    }
+    free_partial(&old);
+    return 1;
+}
+
+/* ray --merge OUT PART...: the parts read, added (image.c checks that
+ * they belong together and leave no hole), and OUT written. */
+static int merge_parts(const Args *a)
+{
+    int n = a->nparts - 1, i, ok = 1;
+    Partial *parts = calloc((size_t)n, sizeof *parts), whole;
+    Output out;
+    Image img;
+    if (!parts) out_of_memory();
+    for (i = 0; i < n && ok; i++) ok = read_partial(a->parts[i + 1], &parts[i]);
+    ok = ok && merge_partials(parts, a->parts + 1, n, &whole);
+    for (i = 0; i < n; i++) free_partial(&parts[i]);
+    free(parts);
+    if (!ok) return 1;
+    if (!open_output(&out, a->output)) {
+        free_partial(&whole);
+        return 1;
+    }
+    if (!new_image(&img, whole.w, whole.h, float_format(out.format), whole.srgb)) {
+        fprintf(stderr, "ray: out of memory for a %dx%d image\n", whole.w, whole.h);
+        discard_output(&out);
+        free_partial(&whole);
+        return 1;
+    }
+    image_of(&whole, &img);
+    ok = write_image(&out, &img, a->plain);
+    free_image(&img);
+    free_partial(&whole);
+    return ok ? 0 : 1;
+}
+
+static void free_args(Args *a)
+{
+    free(a->made);
+    free(a->parts);
+}
+
 /* The program: the command line (cli.c), the scene (scene.c), the
- * structure, the output opened, render(), the image written (image.c). */
+ * structure, the output opened, render(), the image written (image.c).
+ * A split render's part, or a render with checkpoints, keeps each pixel's
+ * sums in a Partial as well (image.h). */
 int main(int argc, char **argv)
 {
     Args a;
@@ -3658,12 +3903,19 @@ int main(int argc, char **argv)
     Counts st;
     Output out;
     Image img;
+    Partial part;
     const char *accel;
-    int ok, done = parse_args(argc, argv, &a);
+    char *checkpoint = NULL;
+    int ok, sig, spp, as_part, done = parse_args(argc, argv, &a);
     double t0, load, build;
     clock_t c0;
 
     if (done >= 0) return done;
+    if (a.merge) {
+        done = merge_parts(&a);
+        free_args(&a);
+        return done;
+    }
     load = now();
     ok = load_scene_for(&s, a.scene, strcmp(a.output, "-") ? a.output : NULL);
     if (ok && a.w) { s.set.w = a.w; s.set.h = a.h; }
@@ -3676,27 +3928,49 @@ int main(int argc, char **argv)
     s.set.no_skip = a.no_skip;
     accel = a.accel ? a.accel : s.set.accel_line ? s.set.accel_line : "auto";
     if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {
-        free_scene(&s); free(a.made);
+        free_scene(&s); free_args(&a);
         return 2;                   /* --no-roulette without -d: a usage error */
     }
-    if (ok) say_what_is_ignored(&s, &a);
     memset(&o, 0, sizeof o);
-    o.spp = a.spp ? a.spp : s.set.spp ? s.set.spp : 1;
+    spp = a.spp ? a.spp : s.set.spp ? s.set.spp : 1;
+    s.set.view = a.view;
+    s.set.adaptive = a.no_skip ? 0 : (real)a.adaptive;
+    s.set.srgb = s.set.integrator == PATH || a.gamma;
+    if (ok && !settle_split(&s, &a, spp, &o.spp)) {
+        free_scene(&s); free_args(&a);
+        return 2;                   /* a part beyond the image: a usage error */
+    }
+    if (ok) say_what_is_ignored(&s, &a);
     o.threads = a.threads;
     build = now();
     ok = ok && build_accel(&s, accel);
     build = now() - build;
-    if (!ok || !open_output(&out, a.output)) { free_scene(&s); free(a.made); return 1; }
+    if (!ok || !open_output(&out, a.output)) { free_scene(&s); free_args(&a); return 1; }
 
-    s.set.view = a.view;
-    s.set.adaptive = a.no_skip ? 0 : (real)a.adaptive;
-    s.set.srgb = s.set.integrator == PATH || a.gamma;
     if (a.view == VIEW_DEPTH) s.set.far = farthest(&s);
-    if (!new_image(&img, s.set.w, s.set.h, float_format(out.format), !a.view && (s.set.integrator == PATH || a.gamma))) {
+    as_part = out.format == FORMAT_PART;
+    if ((as_part || a.checkpoint > 0 || a.resume)
+        && (!start_partial(&s, &o, spp, &part) || !(o.done = calloc((size_t)(s.set.y1 - s.set.y0), 1))))
+        out_of_memory();
+    if (o.done) o.part = &part;
+    if (!as_part && !new_image(&img, s.set.x1 - s.set.x0, s.set.y1 - s.set.y0, float_format(out.format),
+                               !a.view && (s.set.integrator == PATH || a.gamma))) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.set.w, s.set.h);
         discard_output(&out);
-        free_scene(&s); free(a.made);
+        free_scene(&s); free_args(&a);
         return 1;
+    }
+    if (a.resume && !resume_from(a.resume, &part, o.done)) {
+        discard_output(&out);
+        free_scene(&s); free_args(&a);
+        return 1;
+    }
+    if (a.checkpoint > 0) {             /* to OUT.part, and on a stop signal */
+        if (!(checkpoint = malloc(strlen(a.output) + 6))) out_of_memory();
+        sprintf(checkpoint, "%s.part", a.output);
+        o.checkpoint = checkpoint;
+        o.every = a.checkpoint;
+        catch_stop_signals();
     }
     o.progress = stderr_is_terminal();
     memset(&st, 0, sizeof st);
@@ -3704,14 +3978,27 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", s.set.integrator == PATH ? s.warning : s.whitted_warning);
     t0 = o.start = now();
     c0 = clock();
-    render(&s, &o, &img, &st);
+    render(&s, &o, as_part ? NULL : &img, &st);
     t0 = now() - t0;
-    ok = write_image(&out, &img, a.plain);
+    if ((sig = stop_signal())) {        /* the work so far saved, then end as the signal ends */
+        if (save_partial(checkpoint, &part, o.done))
+            fprintf(stderr, "ray: stopped by signal %d; the work so far is in %s: go on with --resume %s\n",
+                    sig, checkpoint, checkpoint);
+        discard_output(&out);
+        end_by_signal(sig);
+        return 1;
+    }
+    if (o.part && !as_part) image_of(&part, &img);     /* the rows resumed too */
+    ok = as_part ? write_partial(&out, &part, NULL) : write_image(&out, &img, a.plain);
+    if (ok && checkpoint) remove(checkpoint);      /* done: no checkpoint to go on from */
     if (a.stats)
         report_stats(&s, &st, o.spp, a.stats == 2, load, build, t0,
                      (double)(clock() - c0) / CLOCKS_PER_SEC);
-    free_image(&img);
-    free(a.made);
+    if (!as_part) free_image(&img);
+    if (o.part) free_partial(&part);
+    free(o.done);
+    free(checkpoint);
+    free_args(&a);
     free_scene(&s);
     return ok ? 0 : 1;
 }

@@ -41,6 +41,7 @@ static Image render_floats(Scene *s, int integrator, int spp, unsigned seed)
     memset(&c, 0, sizeof c);
     o.spp = spp;
     o.threads = 1;
+    whole_image(s);
     render(s, &o, &img, &c);
     return img;
 }

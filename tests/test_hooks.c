@@ -59,6 +59,7 @@ static void render_with(int t, int path, Seen *seen, Image *img)
     o.threads = t;
     o.hooks = &h;
     if (!build_accel(&s, "none") || !new_image(img, s.set.w, s.set.h, 1, 0)) exit(2);
+    whole_image(&s);
     render(&s, &o, img, &c);
     free_scene(&s);
 }
@@ -95,6 +96,7 @@ int main(void)
     memset(&c, 0, sizeof c);
     o.spp = 3;
     if (!build_accel(&s, "none") || !new_image(&plain, s.set.w, s.set.h, 1, 0)) exit(2);
+    whole_image(&s);
     render(&s, &o, &plain, &c);
     memset(want, 0, sizeof want);
     for (j = 0; j < 16; j++)
