@@ -2,6 +2,7 @@
 # make test     the test suite; ends with "N passed, N failed, N skipped"
 # make stress   longer runs than make test: more rays for every acceleration structure, every SPD scene
 # make wine     ray.exe (mingw-w64) run under Wine, its images byte for byte against ./ray's (tests/wine.sh)
+# make farm     the README's GNU parallel and Slurm recipes, run for real here, merged and compared (tests/farm.sh)
 # make bench    time against error, printed as a table and plotted to bench/out/
 # make golf     the code-golf leaderboard (see golf/)
 # make spd      the seven SPD scenes at the benchmark's sizes, generated into scenes/spd/
@@ -10,7 +11,7 @@
 #               FUZZ_SEED=N for libFuzzer's -seed)
 # make install  ./ray and its manual page ray.1 into $(DESTDIR)$(PREFIX)/bin and
 #               $(DESTDIR)$(PREFIX)/share/man/man1 (PREFIX=/usr/local); make uninstall removes them
-# make clean    the programs, ray.1, build/, bench/out, scenes/spd and the images rendered here (*.ppm, *.png, *.pfm, *.exr)
+# make clean    the programs, ray.1, build/, bench/out, scenes/spd and the images and partial renders made here (*.ppm, *.png, *.pfm, *.exr, *.part)
 CC     ?= cc
 CFLAGS ?= -O2
 LDLIBS  = -lm
@@ -103,6 +104,12 @@ stress: all spd
 wine: ray
 	@CFLAGS="$(CFLAGS)" RAY_PARTS="$(RAY_PARTS)" bash tests/wine.sh
 
+# The README's render-farm recipes run for real: GNU parallel, and a Slurm
+# job array on a one-node cluster started here (root; tests/farm.sh).
+farm: ray
+	@bash -c 'out=$$(bash tests/farm.sh 2>&1); echo "$$out"; f=$$(grep -c "^FAIL" <<<"$$out"); \
+	  echo "$$(grep -c "^PASS" <<<"$$out") passed, $$f failed, $$(grep -c "^SKIP" <<<"$$out") skipped"; [ $$f = 0 ]'
+
 # What a user runs: ray and its page.  Not minray, the 1987 card: it takes
 # no options and prints the one 32x32 image to stdout, which ./ray
 # scenes/minray.sph renders too; it is a piece of history to read (minray.c)
@@ -126,9 +133,9 @@ bench: all spd
 
 clean:
 	rm -rf $(PROGS) ray.1 build bench/out scenes/spd
-	rm -f *.ppm *.png *.pfm *.exr
+	rm -f *.ppm *.png *.pfm *.exr *.part
 
 FORCE:
 
-.PHONY: all test stress wine install uninstall bench clean golf spd fuzz FORCE
+.PHONY: all test stress wine farm install uninstall bench clean golf spd fuzz FORCE
 -include golf/golf.mk

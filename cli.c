@@ -441,8 +441,8 @@ static void print_stats_kv(FILE *f, const Stats *st)
             st->cut, st->discarded);
     fprintf(f, "no_skip %d\nskipped_behind %llu\nskipped_faint %llu\n", st->no_skip, st->behind, st->faint);
     if (st->adaptive > 0)
-        fprintf(f, "adaptive_steps %g\nsamples_per_pixel %.4f\nsamples_min %d\nsamples_max %d\n",
-                st->adaptive, (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max);
+        fprintf(f, "adaptive_steps %g\nsamples_taken %llu\nsamples_per_pixel %.4f\nsamples_min %d\nsamples_max %d\n",
+                st->adaptive, st->samples, (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max);
     fprintf(f, "queries %llu\nnearest_queries %llu\nhits %llu\ntests %llu\nsteps %llu\n",
             st->queries, st->nearest, st->hits, st->tests, st->steps);
     fprintf(f, "load_s %.6f\nbuild_s %.6f\nrender_s %.6f\ncpu_s %.6f\n", st->load, st->build,

@@ -3671,7 +3671,7 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.spheres = s->nsph, st.cones = s->ncone, st.triangles = s->ntri, st.objects = nobj(s);
     for (i = 0; i < s->nlight; i++) st.point_lights += s->light[i].sphere < 0;
     st.glowing = glowing(s);
-    st.w = s->set.w, st.h = s->set.h, st.spp = spp, st.threads = c->threads, st.depth = s->set.depth;
+    st.w = s->set.x1 - s->set.x0, st.h = s->set.y1 - s->set.y0, st.spp = spp,   /* a split render: its part */ st.threads = c->threads, st.depth = s->set.depth;
     st.path = s->set.integrator == PATH;
     st.estimator = s->set.estimator;
     st.roulette = s->set.roulette, st.max_rays = s->set.max_rays, st.seed = s->set.seed, st.lights = s->lights.nemit;

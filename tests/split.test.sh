@@ -76,14 +76,35 @@ EOF
 done
 
 # --adaptive: each pixel's rounds are its own, Whitted's neighbours across
-# a crop's edge included; the same bytes as one adaptive run.
-for r in "scenes/whitted.sph -s 60x45 -n 32 --adaptive 2" "scenes/cornell.sph --pt -s 40x30 -n 64 --adaptive 4"; do
+# a crop's edge included; the same bytes as one adaptive run.  edge.sph: a
+# grey wall, dark left of the line between columns 16 and 17, where the
+# crops below are cut: pixels 16 and 17, flat, take 8 samples, not 4, only
+# because their neighbour across the cut disagrees.
+printf 'size 40 30\ncamera 0 0 -10 0 0 0 0 1 0 90\nambient 1 1 1\n' > "$TMP/edge.sph"
+for t in "-100 -100 0  1.5 -100 0  1.5 100 0  .2 .2 .2" "-100 -100 0  1.5 100 0  -100 100 0  .2 .2 .2" \
+         "1.5 -100 0  100 -100 0  100 100 0  .8 .8 .8" "1.5 -100 0  100 100 0  1.5 100 0  .8 .8 .8"; do
+  echo "tri $t  1 0 0 0 1" >> "$TMP/edge.sph"
+done
+for r in "$TMP/edge.sph -n 32 --adaptive 2" "scenes/whitted.sph -s 40x30 -n 32 --adaptive 2" \
+         "scenes/cornell.sph --pt -s 40x30 -n 64 --adaptive 4"; do
   set -- $r
   scene=$1; shift
   whole "$TMP/a.ppm" "$scene" "$@"
   for i in 0 1 2 3; do ./ray "$scene" "$@" --tile $i/4 -o "$TMP/a$i.part" 2>/dev/null; done
   merged "$TMP/m.ppm" "$TMP"/a[0-3].part
   same "--adaptive, in 4 tiles: the whole adaptive run's bytes ($scene $*)" "$TMP/m.ppm" "$TMP/a.ppm"
+  k=0 taken=0
+  for c in 0,0,17,15 17,0,40,15 0,15,17,30 17,15,40,30; do   # quarters: cut across rows and columns
+    ./ray "$scene" "$@" --crop $c --stats=kv -o "$TMP/q$k.part" 2>"$TMP/kv"; k=$((k + 1))
+    taken=$((taken + $(sed -n 's/^samples_taken //p' "$TMP/kv")))
+  done
+  ./ray "$scene" "$@" --stats=kv -o "$TMP/x.ppm" 2>"$TMP/kv"
+  all=$(sed -n 's/^samples_taken //p' "$TMP/kv")
+  [ "$taken" = "$all" ] && ok "--adaptive, in 4 crops: every pixel takes the samples it takes in one run ($taken in all)" \
+    || bad "--adaptive, in 4 crops: $taken samples taken, one run takes $all ($scene $*)"
+  whole "$TMP/a.pfm" "$scene" "$@"
+  merged "$TMP/m.pfm" "$TMP"/q[0-3].part
+  same "--adaptive, in 4 crops: the whole adaptive run's PFM ($scene $*)" "$TMP/m.pfm" "$TMP/a.pfm"
 done
 ./ray scenes/cornell.sph --pt -s 8x8 -n 64 --adaptive 4 --samples 16:64 -o "$TMP/x.part" 2>"$TMP/err"
 [ $? = 2 ] && grep -q "must start at 0" "$TMP/err" && [ ! -e "$TMP/x.part" ] \
