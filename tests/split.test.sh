@@ -52,6 +52,26 @@ for r in W P D; do
   same "$r: ... and to its PPM" "$TMP/m.ppm" "$TMP/$r.ppm"
 done
 
+# A crop written as a picture of its own: the whole image's rectangle, noise
+# and all, in both renderers.
+for r in "scenes/cornell.sph --pt -n 6" "scenes/soft.sph -n 6"; do
+  ./ray $r -s 40x30 -o "$TMP/full.pfm" 2>/dev/null
+  ./ray $r -s 40x30 --crop 7,5,31,22 -o "$TMP/crop.pfm" 2>/dev/null
+  python3 - "$TMP/full.pfm" "$TMP/crop.pfm" <<'EOF' && ok "$r: --crop 7,5,31,22 -o x.pfm is the whole image's rectangle, float for float" || bad "$r: --crop's picture is not the whole image's rectangle"
+import sys
+def pfm(name):
+    d = open(name, 'rb').read()
+    head = d.split(b'\n', 3)
+    w, h = map(int, head[1].split())
+    rows = [head[3][12 * w * y:12 * w * (y + 1)] for y in range(h)][::-1]   # PFM: bottom row first
+    return w, h, rows
+fw, fh, full = pfm(sys.argv[1])
+cw, ch, crop = pfm(sys.argv[2])
+want = [row[12 * 7:12 * 31] for row in full[5:22]]
+sys.exit(0 if (cw, ch) == (24, 17) and crop == want else 1)
+EOF
+done
+
 # The sums themselves: a pixel of 2 samples is the mean of its two
 # one-sample images (--samples 0:1, 1:2), by python's own arithmetic, to
 # within a float's rounding.
