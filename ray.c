@@ -581,7 +581,7 @@ static int triangle_clip(const Scene *s, const Triangle *tr, const double blo[3]
                          const double bhi[3], double lo[3], double hi[3]);
 static void triangle_sample(const Triangle *tr, real u, real v, vec *y, vec *ny);
 static real triangle_pdf(const Triangle *tr, real dist, real cosy);
-static void triangle_light_sample(const Triangle *tr, vec x, real u, real v, vec *y, vec *ny);
+static real triangle_light_sample(const Triangle *tr, vec x, real u, real v, vec *y, vec *ny);
 static real triangle_light_pdf(const Triangle *tr, vec x, real dist, real cosy);
 static real spherical_triangle(const Triangle *tr, vec x, vec c[3], real angle[3]);
 static vec spherical_triangle_sample(const vec c[3], const real angle[3], real area, real u1, real u2);
@@ -1758,10 +1758,10 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u
         *pdf = sphere_sample(&s->sph[k], x, u, v, wi, dist);
         m = &s->mat[s->sph[k].mat];
     } else {
-        triangle_light_sample(&s->tri[k], x, u, v, &y, &ny);
+        real area = triangle_light_sample(&s->tri[k], x, u, v, &y, &ny);   /* its solid angle, or 0 */
         *dist = sqrt(dot(sub(y, x), sub(y, x)));
         *wi = scale(1 / *dist, sub(y, x));
-        *pdf = triangle_light_pdf(&s->tri[k], x, *dist, dot(*wi, ny));
+        *pdf = area > 0 ? 1 / area : triangle_pdf(&s->tri[k], *dist, dot(*wi, ny));   /* triangle_light_pdf's */
         m = &s->mat[s->tri[k].mat];
         if (!front_emits(s, e->obj, ny, scale(-1, *wi))) *pdf = 0;
     }
@@ -2963,19 +2963,21 @@ static real triangle_pdf(const Triangle *tr, real dist, real cosy)
  * differ little (a small or far triangle's dist^2 / cos hardly changes
  * over it) and Arvo's angles lose their precision as the triangle shrinks
  * to a point.  The rule depends on x and the triangle alone, so that
- * light_pdf finds the pdf sample_emitter used. */
+ * light_pdf finds the pdf sample_emitter used.  Returns the solid angle
+ * it sampled by (the pdf is its inverse), or 0 for the area form. */
 #define SOLID_ANGLE_FROM 0.01
-static void triangle_light_sample(const Triangle *tr, vec x, real u, real v, vec *y, vec *ny)
+static real triangle_light_sample(const Triangle *tr, vec x, real u, real v, vec *y, vec *ny)
 {
     vec c[3], wi;
     real angle[3], area = spherical_triangle(tr, x, c, angle);
     if (!(area >= SOLID_ANGLE_FROM)) {
         triangle_sample(tr, u, v, y, ny);
-        return;
+        return 0;
     }
     wi = spherical_triangle_sample(c, angle, area, u, v);
     *ny = unit(cross(tr->e1, tr->e2));
     *y = comb(dot(sub(tr->v0, x), *ny) / dot(wi, *ny), wi, x);   /* where wi meets the plane */
+    return area;
 }
 
 /* The triangle projected onto the unit sphere round x: c, the unit vectors
