@@ -42,6 +42,9 @@ void usage(FILE *to)
           "  --estimator E  the path tracer's: bsdf (BSDF sampling only), nee (next-event\n"
           "             estimation) or mis (both, by multiple importance sampling; default)\n"
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
+          "  --sampler S  the path tracer's numbers: independent (a hash of the sample\n"
+          "             and the dimension; default) or sobol (Owen-scrambled Sobol'\n"
+          "             points, pair by pair: less noise for the same samples)\n"
           "  --seed N   the path tracer's noise, 0 or more (default 0): another N, other\n"
           "             noise\n"
           "  --adaptive E  samples in doubling rounds (from 8; the path tracer's from\n"
@@ -208,6 +211,18 @@ static double seconds_arg(const char *opt, const char *arg)
     return v;
 }
 
+/* --sampler's numbers: 0 independent, 1 sobol; or exit with the choices. */
+static int sampler_arg(const char *v)
+{
+    if (!strcmp(v, "independent")) return 0;
+    if (strcmp(v, "sobol")) {
+        fprintf(stderr, "ray: --sampler takes independent (a hash a number) or sobol (Owen-scrambled"
+                " Sobol' points), not %s\n", v);
+        exit(2);
+    }
+    return 1;
+}
+
 /* The path tracer's estimator named by --estimator, or exit with the choices. */
 static int estimator_arg(const char *v)
 {
@@ -341,7 +356,7 @@ int parse_args(int argc, char **argv, Args *a)
 {
     int i;
     memset(a, 0, sizeof *a);
-    a->integrator = a->estimator = -1;
+    a->integrator = a->estimator = a->sampler = -1;
     a->roulette = 1;
     a->seed = -1;
     for (i = 1; i < argc; i++) {
@@ -366,6 +381,7 @@ int parse_args(int argc, char **argv, Args *a)
         else if ((v = option_value(argc, argv, &i, "--seed"))) a->seed = int_arg("--seed", v, 0, 2147483647);
         else if ((v = option_value(argc, argv, &i, "--estimator"))) a->estimator = estimator_arg(v);
         else if ((v = option_value(argc, argv, &i, "--adaptive"))) a->adaptive = steps_arg("--adaptive", v);
+        else if ((v = option_value(argc, argv, &i, "--sampler"))) a->sampler = sampler_arg(v);
         else if ((v = option_value(argc, argv, &i, "--crop"))) split_arg(a, "--crop", v);
         else if ((v = option_value(argc, argv, &i, "--tile"))) split_arg(a, "--tile", v);
         else if ((v = option_value(argc, argv, &i, "--samples"))) split_arg(a, "--samples", v);

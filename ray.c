@@ -243,6 +243,7 @@ typedef struct {
     real adaptive;            /* --adaptive E: a pixel stops when its byte is known to E steps (0: off) */
     int srgb;                 /* the bytes go through the sRGB curve (for adaptive's rule) */
     int no_skip;              /* --no-skip: no work skipped that the plain algorithm does */
+    int sampler;              /* the path tracer's numbers: INDEPENDENT or SOBOL (--sampler) */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
     int x0, y0, x1, y1;       /* the pixels rendered, x0 <= x < x1, y0 <= y < y1: the whole
                                * image, or a part of it (--crop, --tile) */
@@ -305,6 +306,7 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
 enum { WHITTED, PATH };
 enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
 enum { BSDF_ONLY, NEE, MIS };
+enum { INDEPENDENT, SOBOL };
 
 /* Objects are numbered spheres first, then cones, then triangles. */
 enum { SPHERE, CONE, TRIANGLE };
@@ -366,7 +368,9 @@ typedef struct {
     Counts count;
     int blocker[SHADOW_SLOTS];  /* light i's last blocker, or -1, in slot i % SHADOW_SLOTS */
     unsigned long long key;     /* the path tracer's random numbers: which sample, */
-    int bounce;                 /* and which bounce its path is at (see random01) */
+    int bounce;                 /* and which bounce its path is at (see random01); */
+    unsigned long long pixel_key;   /* --sampler sobol: the pixel's own scramble, */
+    int sample;                 /* and the sample's number in the pixel (-1: the pixel's) */
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
     const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
     long long *splat;           /* this thread's splat image (see splat()), or NULL */
@@ -460,6 +464,7 @@ static void keep_sums(Partial *part, int i, int j, const Tally *t); /* a partial
 /* samples: the points of a pixel, random numbers, the warps and their pdfs */
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k);
 static real random01(const Worker *wk, unsigned dim);
+static double sobol01(const Worker *wk, unsigned dim);
 static real bounce_random(const Worker *wk, int slot);
 static void sample_offset(int k, real anchor, real *dx, real *dy);
 static real time_shift(Worker *wk, const Scene *s, int i, int j);
@@ -851,16 +856,97 @@ enum { LIGHT_CHOICE, LIGHT_U, LIGHT_V, LOBE, DIRECTION_U, DIRECTION_V, ROULETTE,
 static void start_sample(Worker *wk, const Scene *s, int i, int j, int k)
 {
     unsigned long long pixel = (unsigned long long)j * (unsigned)s->set.w + (unsigned)i;
-    wk->key = mix64(mix64(mix64(s->set.seed + 0x9e3779b97f4a7c15ULL) ^ pixel) ^ (unsigned)k);
+    wk->pixel_key = mix64(mix64(s->set.seed + 0x9e3779b97f4a7c15ULL) ^ pixel);
+    wk->key = mix64(wk->pixel_key ^ (unsigned)k);
+    wk->sample = s->set.integrator == PATH && s->set.sampler == SOBOL ? k : -1;
     wk->bounce = 0;
 }
 
-/* The sample's number in dimension dim, uniform in [0, 1). */
+/* The sample's number in dimension dim, uniform in [0, 1): a hash of the
+ * sample's key and the dimension, independent of every other; or with
+ * --sampler sobol, a coordinate of Owen-scrambled Sobol' points (below). */
 static real random01(const Worker *wk, unsigned dim)
 {
-    unsigned long long h = mix64(wk->key + 0x9e3779b97f4a7c15ULL * (dim + 1ULL));
-    real u = (real)((h >> 11) * (1.0 / 9007199254740992.0));
+    real u = (real)(wk->sample >= 0 && dim >= DIM_LENS_U
+                    ? sobol01(wk, dim)
+                    : (mix64(wk->key + 0x9e3779b97f4a7c15ULL * (dim + 1ULL)) >> 11) * (1.0 / 9007199254740992.0));
     return u < 1 ? u : 1 - REAL_EPS;      /* a float may round up to 1 */
+}
+
+/* --sampler sobol: low-discrepancy numbers in every dimension of a path
+ * (Burley, "Practical hash-based Owen scrambling", JCGT 9(4), 2020).  The
+ * dimensions go in pairs that a choice uses together (the lens's u and v,
+ * a light's point, a direction; and the single ones two by two); each
+ * pair's numbers are the first two dimensions of Sobol's sequence, whose
+ * first 2^m points put one point in every box of area 2^-m of any shape
+ * 2^-a by 2^-b (a (0, m, 2)-net: Sobol', 1967).  Every pair of every
+ * pixel has its own scramble (Owen's nested uniform scrambling, 1995, by
+ * Laine and Karras's hash as Burley improves it) and its own shuffle of
+ * the sample numbers: each point alone is uniform, so the mean stays
+ * right; pairs and pixels are independent of each other; and within a
+ * pair, any first 2^m samples of the pixel stay a (0, m, 2)-net. */
+static uint32_t reverse_bits(uint32_t x)
+{
+    x = x << 16 | x >> 16;
+    x = (x & 0x00ff00ffu) << 8 | (x & 0xff00ff00u) >> 8;
+    x = (x & 0x0f0f0f0fu) << 4 | (x & 0xf0f0f0f0u) >> 4;
+    x = (x & 0x33333333u) << 2 | (x & 0xccccccccu) >> 2;
+    return (x & 0x55555555u) << 1 | (x & 0xaaaaaaaau) >> 1;
+}
+
+/* Owen's scramble, on bits reversed (the first binary digit of a number in
+ * [0, 1) as the lowest bit): each bit flipped or not by a hash of the bits
+ * below it, which Laine and Karras's hash does, since multiplying by an
+ * even number carries only upward. */
+static uint32_t owen_reversed(uint32_t x, uint32_t seed)
+{
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+/* Sobol's second dimension at index i, its digits reversed (its first is
+ * i itself, reversed: van der Corput's).  Its direction numbers, those of
+ * the polynomial x + 1, are the rows of Pascal's triangle mod 2, so digit
+ * j is the parity of the bits i_k with C(k, j) odd, which by Lucas's
+ * theorem are those whose k has every bit of j: a sum over supersets of
+ * bit positions, five shifts and masks (one for each bit of a position). */
+static uint32_t sobol_second_reversed(uint32_t i)
+{
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    return i ^ ((i >> 16) & 0x0000ffffu);
+}
+
+/* Which pair a dimension belongs to, and which of its two it is. */
+static unsigned pair_of(unsigned dim, int *second)
+{
+    static const unsigned char pair[BOUNCE_DIMS] = { 0, 1, 1, 0, 2, 2, 3, 3 };   /* by slot */
+    static const unsigned char which[BOUNCE_DIMS] = { 0, 0, 1, 1, 0, 1, 0, 1 };
+    unsigned slot;
+    if (dim < DIM_BOUNCE) {             /* the lens's u, v; the time alone */
+        *second = dim == DIM_LENS_V;
+        return dim == DIM_TIME;
+    }
+    slot = (dim - DIM_BOUNCE) % BOUNCE_DIMS;
+    *second = which[slot];
+    return 2 + 4 * ((dim - DIM_BOUNCE) / BOUNCE_DIMS) + pair[slot];
+}
+
+static double sobol01(const Worker *wk, unsigned dim)
+{
+    int second;
+    unsigned pair = pair_of(dim, &second);
+    unsigned long long h = mix64(wk->pixel_key ^ (0xd1b54a32d192ed03ULL * (pair + 1ULL)));
+    /* the pair's own order of the samples: i an Owen scramble of the number k */
+    uint32_t i = reverse_bits(owen_reversed(reverse_bits((uint32_t)wk->sample), (uint32_t)h));
+    uint32_t x = second ? sobol_second_reversed(i) : i;     /* the point's digits, reversed */
+    return reverse_bits(owen_reversed(x, (uint32_t)(h >> 32) ^ (second ? 0x9e3779b9u : 0))) * (1.0 / 4294967296.0);
 }
 
 /* The number in `slot` of the block of the bounce the path is at. */
@@ -3348,10 +3434,10 @@ static int start_partial(const Scene *s, const Options *o, int spp, Partial *p)
     p->s0 = s->set.s0, p->s1 = s->set.s0 + o->spp;
     p->srgb = s->set.srgb;
     sprintf(p->about, "version %s\nscene %016llx\nrenderer %s\ndepth %d\nmax_rays %d\nestimator %d\n"
-            "roulette %d\nseed %u\nadaptive %.17g\nno_skip %d\n", program_version(),
+            "roulette %d\nseed %u\nadaptive %.17g\nno_skip %d\nsampler %d\n", program_version(),
             (unsigned long long)scene_hash(s), s->set.integrator == PATH ? "path" : "whitted", s->set.depth,
             s->set.max_rays, s->set.estimator, s->set.roulette, s->set.seed, (double)s->set.adaptive,
-            s->set.no_skip);
+            s->set.no_skip, s->set.sampler);
     return new_partial(p);
 }
 
@@ -3928,6 +4014,7 @@ int main(int argc, char **argv)
                 " lit by one light\n", a.scene);
     if (a.depth) s.set.depth = s.set.max_rays = a.depth;
     s.set.no_skip = a.no_skip;
+    if (a.sampler >= 0) s.set.sampler = a.sampler;
     accel = a.accel ? a.accel : s.set.accel_line ? s.set.accel_line : "auto";
     if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {
         free_scene(&s); free_args(&a);
