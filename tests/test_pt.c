@@ -467,6 +467,16 @@ static void sky_checks(void)
          * factors cancel whatever they are). */
         { "inside a glass ball (n = 1.5) a white room is n^2 = 2.25 times brighter", 1, 0, 0, 1,
           { 0.2, 0.1, -0.3 }, { 1, 0.5, 0 }, 90, 2.25 },
+        /* The same from 0.65 of the radius out, looking along the wall:
+         * the rays meet it at 40.5 degrees, just short of the critical
+         * angle (41.8), and at every meeting (a ball keeps the angle)
+         * Fresnel reflects 0.30, so that about 1 path in 36 makes 4 rays
+         * inside and meets the roulette there: those that leave then have
+         * a throughput of n^2 = 2.25, more than 1, which the roulette's
+         * chance must not follow (at most 0.95: a chance of 2.25 keeps
+         * them all and counts each 1/2.25 times). */
+        { "inside a glass ball, along its wall (Fresnel 0.3, some paths reach the roulette): n^2 = 2.25"
+          " times brighter", 1, 0, 0, 1, { 0.65, 0, 0 }, { 0.65, 1, 0 }, 1, 2.25 },
         /* A convex Lambertian ball of albedo a under a sky of radiance L
          * sees only sky: it reflects a L, the sky sampled and weighed as a
          * light by each estimator. */
