@@ -427,6 +427,55 @@ static void test_polygon_lights(void)
         }
 }
 
+/* Shading normals: a floor whose triangles carry vertex normals tilted 20
+ * degrees (towards +x) from their geometric normal, up, under the quad
+ * lamp of test_polygon_lights.  The floor's BSDF takes its cosines about
+ * the shading normal n, so the radiance of a floor point is rho/pi E with
+ * E Lambert's irradiance about n (the lamp lies above both horizons, n's
+ * and the plane's, from every point looked at: x, y in [-1.5, 1.5]), some
+ * 5% less than about the plane's normal straight up.  Light sampling (nee,
+ * mis) must weigh its samples by cos to n, as BSDF sampling does by drawing
+ * about n.  40000 points, direct light only, within K standard errors. */
+static void test_shading_normals(void)
+{
+    static const vec quad4[4] = { { -1, -0.8, 1.5 }, { -0.7, 0.9, 1.5 }, { 0.9, 1.1, 1.5 }, { 1.2, -1, 1.5 } };
+    double Le = 2, rho = 0.7, tilt = 20 * PI / 180;
+    vec n = v3(sin(tilt), 0, cos(tilt));
+    int e, k;
+    char name[200];
+    for (e = 0; e < 3; e++) {
+        Scene s;
+        Worker wk = worker();
+        Stat st = { 0, 0, 0 }, want = { 0, 0, 0 };
+        int floor_mat, a, b, c, d, nn;
+        default_scene(&s);
+        floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
+        a = add_vertex(&s, v3(-6, -6, 0)), b = add_vertex(&s, v3(6, -6, 0));
+        c = add_vertex(&s, v3(6, 6, 0)), d = add_vertex(&s, v3(-6, 6, 0));
+        nn = add_normal(&s, n);
+        add_triangle(&s, a, b, c, nn, nn, nn, floor_mat);
+        add_triangle(&s, a, c, d, nn, nn, nn, floor_mat);
+        s.cull = 1;                          /* the lamp lights from its front, below */
+        quad(&s, quad4[0], quad4[1], quad4[2], quad4[3], material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
+        ready(&s, e, 0, 2);
+        for (k = 0; k < 40000; k++) {
+            vec p, L;
+            double E;
+            start_sample(&wk, &s, k, 4, 0);
+            p = v3(3 * random01(&wk, DIM_PIXEL_X) - 1.5, 3 * random01(&wk, DIM_PIXEL_Y) - 1.5, 0);
+            L = radiance_along(&s, v3(p.x, p.y, 0.5), v3(0, 0, -1), &wk);
+            E = lambert_polygon(quad4, 4, p, n, Le);
+            stat_add(&st, L.x - rho / PI * E);
+            stat_add(&want, rho / PI * E);
+        }
+        sprintf(name, "a floor with shading normals tilted 20 degrees under a quad lamp: Lambert's formula"
+                " about the shading normal, %s", est_name[e]);
+        report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points, where rho/pi E is %.4g"
+               " on average", stat_mean(&st), stat_se(&st), st.n, stat_mean(&want));
+        free_scene(&s);
+    }
+}
+
 /* ---- one ball under a uniform sky ---- */
 
 /* The mean radiance seen by a camera (eye, looking at `at`, fov) of one
@@ -1493,6 +1542,7 @@ int main(void)
     test_sphere_is_point();
     test_glass_split();
     test_polygon_lights();
+    test_shading_normals();
     sky_checks();
     test_estimators_agree();
     test_veach();
