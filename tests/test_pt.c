@@ -375,23 +375,30 @@ static double lambert_polygon(const vec *v, int n, vec x, vec nx, double L)
  * where a bias only moves a mean no test knew, let that through).  And the
  * triangle again behind a black square just below it, which hides it from
  * every point of the floor looked at: E = 0, so that a shadow ray that
- * stops short of the lamp (sees only the blockers near the floor) fails. */
+ * stops short of the lamp (sees only the blockers near the floor) fails.
+ * And a far triangle, 400 above the floor, whose solid angle (0.008) is
+ * below SOLID_ANGLE_FROM, so that sample_emitter picks its points by area
+ * and light_pdf turns that pdf into solid angle, dist^2 / (A cos): MIS
+ * weighs a BSDF sample that finds the lamp by it, and with a pdf off by a
+ * factor dist (400) the weights of a direction no longer sum to 1. */
 static void test_polygon_lights(void)
 {
     static const vec tri[3] = { { -1, -0.5, 1.6 }, { 0.2, 1.3, 1.4 }, { 1.2, -0.9, 1.1 } };
     static const vec quad4[4] = { { -1, -0.8, 1.5 }, { -0.7, 0.9, 1.5 }, { 0.9, 1.1, 1.5 }, { 1.2, -1, 1.5 } };
+    static const vec far[3] = { { -30, -20, 400 }, { 2, 24, 400 }, { 32, -18, 400 } };
     static const char *const how[4] = { "bsdf", "nee", "mis", "Whitted's area light" };
-    static const char *const what[3] = {
+    static const char *const what[4] = {
         "a triangle lamp lights a floor as Lambert's polygon formula says",
         "a quad lamp (two triangles) lights a floor as Lambert's polygon formula says",
         "a triangle lamp behind a black square just below it lights nothing",
+        "a far triangle lamp (0.008 sr: sampled by area) lights a floor as Lambert's polygon formula says",
     };
     double Le = 2, rho = 0.7;
     int lamp, e, k;
     char name[200];
-    for (lamp = 0; lamp < 3; lamp++)
+    for (lamp = 0; lamp < 4; lamp++)
         for (e = 0; e < 4; e++) {
-            const vec *v = lamp == 1 ? quad4 : tri;
+            const vec *v = lamp == 1 ? quad4 : lamp == 3 ? far : tri;
             int nv = lamp == 1 ? 4 : 3, light;
             Scene s;
             Worker wk = worker();
