@@ -222,38 +222,45 @@ static void test_point_in_sphere(void)
  * intensity Phi / 4 pi = pi r^2 Le at its centre: E = I cos(theta) / d^2.
  * A floor of albedo rho under a sphere light; the radiance of random floor
  * points straight up, direct light only (2 rays a path), against
- * rho / pi * I cos(theta) / d^2 point by point. */
+ * rho / pi * I cos(theta) / d^2 point by point.  And again with a black
+ * ball inside the lamp (radius 0.8 r, at its centre), which the lamp hides
+ * from every point outside it: a shadow ray must stop where the ray meets
+ * the lamp's near side, not its far side (the sample's ray through the
+ * lamp passes the ball on the way there). */
 static void test_sphere_is_point(void)
 {
     double r = 0.5, Le = 2, rho = 0.7, I = PI * r * r * Le;
     vec c = v3(0.7, -0.4, 2.2);
-    int e;
+    int e, inside;
     char name[160];
-    for (e = 0; e < 3; e++) {
-        Scene s;
-        Worker wk = worker();
-        Stat st = { 0, 0, 0 };
-        int floor_mat, k;
-        default_scene(&s);
-        floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
-        quad(&s, v3(-6, -6, 0), v3(6, -6, 0), v3(6, 6, 0), v3(-6, 6, 0), floor_mat);
-        add_sphere(&s, c, r, material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
-        ready(&s, e, 0, 2);
-        for (k = 0; k < 40000; k++) {
-            vec p, d, L;
-            double want;
-            start_sample(&wk, &s, k, 1, 0);     /* the point takes the pixel's dimensions */
-            p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
-            L = radiance_along(&s, v3(p.x, p.y, 1), v3(0, 0, -1), &wk);   /* below the light */
-            d = sub(c, p);
-            want = rho / PI * I * d.z / sqrt(dot(d, d)) / dot(d, d);
-            stat_add(&st, L.x - want);
+    for (inside = 0; inside < 2; inside++)
+        for (e = 0; e < 3; e++) {
+            Scene s;
+            Worker wk = worker();
+            Stat st = { 0, 0, 0 };
+            int floor_mat, k;
+            default_scene(&s);
+            floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
+            quad(&s, v3(-6, -6, 0), v3(6, -6, 0), v3(6, 6, 0), v3(-6, 6, 0), floor_mat);
+            add_sphere(&s, c, r, material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
+            if (inside) add_sphere(&s, c, 0.8 * r, material(&s, v3(1, 1, 1), 0, 0, 0, 0, 1, 0));
+            ready(&s, e, 0, 2);
+            for (k = 0; k < 40000; k++) {
+                vec p, d, L;
+                double want;
+                start_sample(&wk, &s, k, 1, 0);     /* the point takes the pixel's dimensions */
+                p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
+                L = radiance_along(&s, v3(p.x, p.y, 1), v3(0, 0, -1), &wk);   /* below the light */
+                d = sub(c, p);
+                want = rho / PI * I * d.z / sqrt(dot(d, d)) / dot(d, d);
+                stat_add(&st, L.x - want);
+            }
+            sprintf(name, "sphere light = point light of intensity Phi/4pi on a floor%s, %s",
+                    inside ? ", a black ball inside the lamp" : "", est_name[e]);
+            report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points", stat_mean(&st),
+                   stat_se(&st), st.n);
+            free_scene(&s);
         }
-        sprintf(name, "sphere light = point light of intensity Phi/4pi on a floor, %s", est_name[e]);
-        report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points", stat_mean(&st),
-               stat_se(&st), st.n);
-        free_scene(&s);
-    }
 }
 
 /* ---- glass: Fresnel's share reflected, the rest refracted ---- */
