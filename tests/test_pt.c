@@ -222,38 +222,45 @@ static void test_point_in_sphere(void)
  * intensity Phi / 4 pi = pi r^2 Le at its centre: E = I cos(theta) / d^2.
  * A floor of albedo rho under a sphere light; the radiance of random floor
  * points straight up, direct light only (2 rays a path), against
- * rho / pi * I cos(theta) / d^2 point by point. */
+ * rho / pi * I cos(theta) / d^2 point by point.  And again with a black
+ * ball inside the lamp (radius 0.8 r, at its centre), which the lamp hides
+ * from every point outside it: a shadow ray must stop where the ray meets
+ * the lamp's near side, not its far side (the sample's ray through the
+ * lamp passes the ball on the way there). */
 static void test_sphere_is_point(void)
 {
     double r = 0.5, Le = 2, rho = 0.7, I = PI * r * r * Le;
     vec c = v3(0.7, -0.4, 2.2);
-    int e;
+    int e, inside;
     char name[160];
-    for (e = 0; e < 3; e++) {
-        Scene s;
-        Worker wk = worker();
-        Stat st = { 0, 0, 0 };
-        int floor_mat, k;
-        default_scene(&s);
-        floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
-        quad(&s, v3(-6, -6, 0), v3(6, -6, 0), v3(6, 6, 0), v3(-6, 6, 0), floor_mat);
-        add_sphere(&s, c, r, material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
-        ready(&s, e, 0, 2);
-        for (k = 0; k < 40000; k++) {
-            vec p, d, L;
-            double want;
-            start_sample(&wk, &s, k, 1, 0);     /* the point takes the pixel's dimensions */
-            p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
-            L = radiance_along(&s, v3(p.x, p.y, 1), v3(0, 0, -1), &wk);   /* below the light */
-            d = sub(c, p);
-            want = rho / PI * I * d.z / sqrt(dot(d, d)) / dot(d, d);
-            stat_add(&st, L.x - want);
+    for (inside = 0; inside < 2; inside++)
+        for (e = 0; e < 3; e++) {
+            Scene s;
+            Worker wk = worker();
+            Stat st = { 0, 0, 0 };
+            int floor_mat, k;
+            default_scene(&s);
+            floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
+            quad(&s, v3(-6, -6, 0), v3(6, -6, 0), v3(6, 6, 0), v3(-6, 6, 0), floor_mat);
+            add_sphere(&s, c, r, material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
+            if (inside) add_sphere(&s, c, 0.8 * r, material(&s, v3(1, 1, 1), 0, 0, 0, 0, 1, 0));
+            ready(&s, e, 0, 2);
+            for (k = 0; k < 40000; k++) {
+                vec p, d, L;
+                double want;
+                start_sample(&wk, &s, k, 1, 0);     /* the point takes the pixel's dimensions */
+                p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
+                L = radiance_along(&s, v3(p.x, p.y, 1), v3(0, 0, -1), &wk);   /* below the light */
+                d = sub(c, p);
+                want = rho / PI * I * d.z / sqrt(dot(d, d)) / dot(d, d);
+                stat_add(&st, L.x - want);
+            }
+            sprintf(name, "sphere light = point light of intensity Phi/4pi on a floor%s, %s",
+                    inside ? ", a black ball inside the lamp" : "", est_name[e]);
+            report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points", stat_mean(&st),
+                   stat_se(&st), st.n);
+            free_scene(&s);
         }
-        sprintf(name, "sphere light = point light of intensity Phi/4pi on a floor, %s", est_name[e]);
-        report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points", stat_mean(&st),
-               stat_se(&st), st.n);
-        free_scene(&s);
-    }
 }
 
 /* ---- glass: Fresnel's share reflected, the rest refracted ---- */
@@ -375,23 +382,30 @@ static double lambert_polygon(const vec *v, int n, vec x, vec nx, double L)
  * where a bias only moves a mean no test knew, let that through).  And the
  * triangle again behind a black square just below it, which hides it from
  * every point of the floor looked at: E = 0, so that a shadow ray that
- * stops short of the lamp (sees only the blockers near the floor) fails. */
+ * stops short of the lamp (sees only the blockers near the floor) fails.
+ * And a far triangle, 400 above the floor, whose solid angle (0.008) is
+ * below SOLID_ANGLE_FROM, so that sample_emitter picks its points by area
+ * and light_pdf turns that pdf into solid angle, dist^2 / (A cos): MIS
+ * weighs a BSDF sample that finds the lamp by it, and with a pdf off by a
+ * factor dist (400) the weights of a direction no longer sum to 1. */
 static void test_polygon_lights(void)
 {
     static const vec tri[3] = { { -1, -0.5, 1.6 }, { 0.2, 1.3, 1.4 }, { 1.2, -0.9, 1.1 } };
     static const vec quad4[4] = { { -1, -0.8, 1.5 }, { -0.7, 0.9, 1.5 }, { 0.9, 1.1, 1.5 }, { 1.2, -1, 1.5 } };
+    static const vec far[3] = { { -30, -20, 400 }, { 2, 24, 400 }, { 32, -18, 400 } };
     static const char *const how[4] = { "bsdf", "nee", "mis", "Whitted's area light" };
-    static const char *const what[3] = {
+    static const char *const what[4] = {
         "a triangle lamp lights a floor as Lambert's polygon formula says",
         "a quad lamp (two triangles) lights a floor as Lambert's polygon formula says",
         "a triangle lamp behind a black square just below it lights nothing",
+        "a far triangle lamp (0.008 sr: sampled by area) lights a floor as Lambert's polygon formula says",
     };
     double Le = 2, rho = 0.7;
     int lamp, e, k;
     char name[200];
-    for (lamp = 0; lamp < 3; lamp++)
+    for (lamp = 0; lamp < 4; lamp++)
         for (e = 0; e < 4; e++) {
-            const vec *v = lamp == 1 ? quad4 : tri;
+            const vec *v = lamp == 1 ? quad4 : lamp == 3 ? far : tri;
             int nv = lamp == 1 ? 4 : 3, light;
             Scene s;
             Worker wk = worker();
@@ -425,6 +439,55 @@ static void test_polygon_lights(void)
                    " on average", stat_mean(&st), stat_se(&st), st.n, stat_mean(&want));
             free_scene(&s);
         }
+}
+
+/* Shading normals: a floor whose triangles carry vertex normals tilted 20
+ * degrees (towards +x) from their geometric normal, up, under the quad
+ * lamp of test_polygon_lights.  The floor's BSDF takes its cosines about
+ * the shading normal n, so the radiance of a floor point is rho/pi E with
+ * E Lambert's irradiance about n (the lamp lies above both horizons, n's
+ * and the plane's, from every point looked at: x, y in [-1.5, 1.5]), some
+ * 5% less than about the plane's normal straight up.  Light sampling (nee,
+ * mis) must weigh its samples by cos to n, as BSDF sampling does by drawing
+ * about n.  40000 points, direct light only, within K standard errors. */
+static void test_shading_normals(void)
+{
+    static const vec quad4[4] = { { -1, -0.8, 1.5 }, { -0.7, 0.9, 1.5 }, { 0.9, 1.1, 1.5 }, { 1.2, -1, 1.5 } };
+    double Le = 2, rho = 0.7, tilt = 20 * PI / 180;
+    vec n = v3(sin(tilt), 0, cos(tilt));
+    int e, k;
+    char name[200];
+    for (e = 0; e < 3; e++) {
+        Scene s;
+        Worker wk = worker();
+        Stat st = { 0, 0, 0 }, want = { 0, 0, 0 };
+        int floor_mat, a, b, c, d, nn;
+        default_scene(&s);
+        floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
+        a = add_vertex(&s, v3(-6, -6, 0)), b = add_vertex(&s, v3(6, -6, 0));
+        c = add_vertex(&s, v3(6, 6, 0)), d = add_vertex(&s, v3(-6, 6, 0));
+        nn = add_normal(&s, n);
+        add_triangle(&s, a, b, c, nn, nn, nn, floor_mat);
+        add_triangle(&s, a, c, d, nn, nn, nn, floor_mat);
+        s.cull = 1;                          /* the lamp lights from its front, below */
+        quad(&s, quad4[0], quad4[1], quad4[2], quad4[3], material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0));
+        ready(&s, e, 0, 2);
+        for (k = 0; k < 40000; k++) {
+            vec p, L;
+            double E;
+            start_sample(&wk, &s, k, 4, 0);
+            p = v3(3 * random01(&wk, DIM_PIXEL_X) - 1.5, 3 * random01(&wk, DIM_PIXEL_Y) - 1.5, 0);
+            L = radiance_along(&s, v3(p.x, p.y, 0.5), v3(0, 0, -1), &wk);
+            E = lambert_polygon(quad4, 4, p, n, Le);
+            stat_add(&st, L.x - rho / PI * E);
+            stat_add(&want, rho / PI * E);
+        }
+        sprintf(name, "a floor with shading normals tilted 20 degrees under a quad lamp: Lambert's formula"
+                " about the shading normal, %s", est_name[e]);
+        report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points, where rho/pi E is %.4g"
+               " on average", stat_mean(&st), stat_se(&st), st.n, stat_mean(&want));
+        free_scene(&s);
+    }
 }
 
 /* ---- one ball under a uniform sky ---- */
@@ -467,6 +530,16 @@ static void sky_checks(void)
          * factors cancel whatever they are). */
         { "inside a glass ball (n = 1.5) a white room is n^2 = 2.25 times brighter", 1, 0, 0, 1,
           { 0.2, 0.1, -0.3 }, { 1, 0.5, 0 }, 90, 2.25 },
+        /* The same from 0.65 of the radius out, looking along the wall:
+         * the rays meet it at 40.5 degrees, just short of the critical
+         * angle (41.8), and at every meeting (a ball keeps the angle)
+         * Fresnel reflects 0.30, so that about 1 path in 36 makes 4 rays
+         * inside and meets the roulette there: those that leave then have
+         * a throughput of n^2 = 2.25, more than 1, which the roulette's
+         * chance must not follow (at most 0.95: a chance of 2.25 keeps
+         * them all and counts each 1/2.25 times). */
+        { "inside a glass ball, along its wall (Fresnel 0.3, some paths reach the roulette): n^2 = 2.25"
+          " times brighter", 1, 0, 0, 1, { 0.65, 0, 0 }, { 0.65, 1, 0 }, 1, 2.25 },
         /* A convex Lambertian ball of albedo a under a sky of radiance L
          * sees only sky: it reflects a L, the sky sampled and weighed as a
          * light by each estimator. */
@@ -1268,6 +1341,152 @@ static void test_mis_variance(void)
     for (e = 0; e < 3; e++) free_scene(&s[e]);
 }
 
+/* ---- MIS's weights: a plate under a sky ---- */
+
+/* A plate (the quad z = 0, 200 wide) of a white material kd ks (a Phong
+ * exponent shine, or 0: ks is a mirror) under a uniform sky of radiance L,
+ * ready for estimator e.  A point light below it lights only its underside
+ * (from above, cos theta_i < 0), but it halves the sky's chance to be the
+ * light chosen, so that the sky's pdf is c cos(theta_i) / pi with c = 1/2
+ * and not the Lambertian lobe's cosine pdf.  The plate's front faces down:
+ * a ray from above meets its back, where bsdf_at turns the normals up, and
+ * the normal a path leaves with (which the sky's pdf is measured about) must
+ * be the turned one. */
+static void plate_in_sky(Scene *s, double L, double kd, double ks, double shine, int e)
+{
+    default_scene(s);
+    s->background = v3(L, L, L);
+    quad(s, v3(-100, -100, 0), v3(-100, 100, 0), v3(100, 100, 0), v3(100, -100, 0),
+         material(s, v3(1, 1, 1), kd, ks, 0, 0, 1, shine));
+    add_light(s, v3(0, 0, -1), v3(1, 1, 1), -1);
+    ready(s, e, 1, 0);
+}
+
+/* A modified Phong lobe of ks 1 (kd 0), f = (n+2)/(2 pi) cos^n(alpha), alpha
+ * the angle to the mirror direction of wo at theta_o, under a uniform sky of
+ * radiance L, by the midpoint rule on QT x QP cells of the hemisphere: in
+ * *albedo the integral of f cos theta_i, and for MIS, the sum of one BSDF
+ * sample (the lobe's pdf (n+1)/(2 pi) cos^n(alpha)) and one light sample
+ * (the sky's c cos(theta_i) / pi), each weighed by the heuristic
+ * p^beta / (p_bsdf^beta + p_light^beta) of its own pdf p (beta 2: the power
+ * heuristic, 1: the balance heuristic), its mean and variance.  The two
+ * samples are independent, so the variance is the sum of each one's,
+ * E[(w f cos L / p)^2] - E[w f cos L / p]^2 over its own pdf p (Veach's
+ * multi-sample estimator, thesis 1997, chapter 9, one sample of each). */
+static void phong_sky_mis(double shine, double theta_o, double c, double beta, double L,
+                          double *albedo, double *mean, double *var)
+{
+    vec r = polar(theta_o, PI);
+    double a = 0, ml = 0, mb = 0, sl = 0, sb = 0, cell = (PI / 2 / QT) * (2 * PI / QP);
+    int i, j;
+    for (i = 0; i < QT; i++) {
+        double ti = PI / 2 * (i + 0.5) / QT;
+        for (j = 0; j < QP; j++) {
+            vec wi = polar(ti, 2 * PI * (j + 0.5) / QP);
+            double ca = dot(wi, r), lobe, g, pb, pl, wl, wb, dw;
+            if (!(ca > 0)) continue;
+            lobe = pow(ca, shine) / (2 * PI);
+            pb = (shine + 1) * lobe, pl = c * wi.z / PI;
+            g = (shine + 2) * lobe * wi.z * L;
+            wl = pow(pl, beta) / (pow(pl, beta) + pow(pb, beta)), wb = 1 - wl;
+            dw = sin(ti) * cell;
+            a += g * dw, ml += wl * g * dw, mb += wb * g * dw;
+            sl += wl * wl * g * g / pl * dw;
+            if (pb > 0) sb += wb * wb * g * g / pb * dw;
+        }
+    }
+    *albedo = a / L, *mean = ml + mb, *var = sl - ml * ml + sb - mb * mb;
+}
+
+/* The radiance a plate_in_sky sends back along polar(theta_o, 0), by
+ * n paths, its red channel's samples in x (if not NULL) and returned their
+ * Stat. */
+static Stat plate_samples(const Scene *s, double theta_o, int n, double *x)
+{
+    Worker wk = worker();
+    Stat st = { 0, 0, 0 };
+    vec wo = polar(theta_o, 0);
+    int k;
+    for (k = 0; k < n; k++) {
+        double L;
+        start_sample(&wk, s, 0, 0, k);
+        L = radiance_along(s, wo, scale(-1, wo), &wk).x;
+        stat_add(&st, L);
+        if (x) x[k] = L;
+    }
+    return st;
+}
+
+/* The plate under a sky of 0.8 sends back 0.8 times its albedo whatever the
+ * estimator: the Phong lobe's by phong_sky_mis's quadrature, Lambert and a
+ * mirror's kd + ks.  Each estimator, 20000 paths, within K standard
+ * errors.  MIS weighs each of its two samples by the power heuristic of
+ * the two pdfs, and the weights of a direction sum to 1 only if the sky's
+ * pdf that emitted() weighs a BSDF sample by is the one sample_light drew
+ * with (its choice c = 1/2 included, measured about the turned normal), and
+ * the BSDF's pdf the one sample_bsdf drew with (its lobe's chance included:
+ * p_diffuse = 0.5 / 0.8 beside the mirror).  Such slips show only where the
+ * two pdfs differ, as here: a Lambertian ball alone under a sky (sky_checks)
+ * has the cosine pdf for both, and any weights, swapped or not, share it
+ * alike.  Phong 1 from 70 degrees sends a third of its samples below the
+ * horizon: the path ends there, but the light sample taken before it still
+ * counts. */
+static void test_plate_in_sky(void)
+{
+    static const struct { const char *name; double kd, ks, shine, degrees; } c[] = {
+        { "Phong 1", 0, 1, 1, 70 },
+        { "Phong 10", 0, 1, 10, 30 },
+        { "Lambert 0.5 + mirror 0.3", 0.5, 0.3, 0, 30 },
+    };
+    double L = 0.8;
+    int q, e;
+    char name[240];
+    for (q = 0; q < (int)(sizeof c / sizeof c[0]); q++) {
+        double th = c[q].degrees * PI / 180, albedo = c[q].kd + c[q].ks, mean, var;
+        if (c[q].shine > 0) phong_sky_mis(c[q].shine, th, 0.5, 2, L, &albedo, &mean, &var);
+        for (e = 0; e < 3; e++) {
+            Scene s;
+            Stat st;
+            plate_in_sky(&s, L, c[q].kd, c[q].ks, c[q].shine, e);
+            st = plate_samples(&s, th, 20000, NULL);
+            sprintf(name, "a plate of %s seen from %g degrees on its back, under a sky of 0.8 and over a point"
+                    " light: 0.8 times its albedo%s, %s", c[q].name, c[q].degrees,
+                    c[q].shine > 0 ? " (quadrature)" : " kd + ks", est_name[e]);
+            report(agrees(&st, L * albedo), name, "%.5f +- %.5f, want %.5f", stat_mean(&st), stat_se(&st),
+                   L * albedo);
+            free_scene(&s);
+        }
+    }
+}
+
+/* MIS's variance on that plate of Phong 10 seen from 30 degrees: the
+ * balance heuristic and the power heuristic are both unbiased, and only
+ * the noise tells them apart.  phong_sky_mis integrates the variance of
+ * the sum of a path's two samples (the light's and the BSDF's, each
+ * weighed) for either: here the power heuristic's is 0.56 times the balance
+ * heuristic's, as Veach (thesis, chapter 9) made the power heuristic for:
+ * where one technique (here the lobe's own) is far better than the other,
+ * it gives that one more of the weight.  The sample variance of N
+ * paths within K of its standard errors (Cramer's (m4 - s^4) / N, as
+ * test_mis_variance) of the power heuristic's. */
+static void test_plate_mis_variance(void)
+{
+    enum { N = 20000 };
+    static double x[N];
+    double th = 30 * PI / 180, albedo, mean, v_power, v_balance, m, v, se;
+    Scene s;
+    phong_sky_mis(10, th, 0.5, 2, 1, &albedo, &mean, &v_power);
+    phong_sky_mis(10, th, 0.5, 1, 1, &albedo, &mean, &v_balance);
+    plate_in_sky(&s, 1, 0, 1, 10, MIS);
+    plate_samples(&s, th, N, x);
+    sample_moments(x, N, &m, &v, &se);
+    report(fabs(v - v_power) <= K * se,
+           "MIS on a plate of Phong 10 from 30 degrees under a sky: the variance of a path is the power"
+           " heuristic's (quadrature of Veach's multi-sample estimator)",
+           "%.5f +- %.5f, want %.5f (the balance heuristic's: %.5f)", v, se, v_power, v_balance);
+    free_scene(&s);
+}
+
 /* A cone that glows is no light sample_light can choose, so whatever the
  * estimator, its light is found by BSDF sampling alone and counts in full:
  * all three must agree on a ball lit by it (NEE used to drop it, MIS to
@@ -1337,10 +1556,13 @@ int main(void)
     test_sphere_is_point();
     test_glass_split();
     test_polygon_lights();
+    test_shading_normals();
     sky_checks();
     test_estimators_agree();
     test_veach();
     test_mis_variance();
+    test_plate_in_sky();
+    test_plate_mis_variance();
     test_glowing_cone();
     test_seed();
     return failures != 0;
