@@ -412,6 +412,7 @@ int parse_args(int argc, char **argv, Args *a)
     if (!a->output) a->output = a->made = default_output(a->name);
     if (!output_usable(a->output, a->plain) || (strcmp(a->scene, "-") && !apart(a->scene, a->output))) {
         free(a->made);
+        a->made = NULL;
         return 2;
     }
     warn_threads(a->threads);

@@ -3998,7 +3998,10 @@ int main(int argc, char **argv)
     double t0, load, build;
     clock_t c0;
 
-    if (done >= 0) return done;
+    if (done >= 0) {                    /* --help, or a usage error */
+        free_args(&a);
+        return done;
+    }
     if (a.merge) {
         done = merge_parts(&a);
         free_args(&a);
