@@ -387,23 +387,27 @@ static double lambert_polygon(const vec *v, int n, vec x, vec nx, double L)
  * below SOLID_ANGLE_FROM, so that sample_emitter picks its points by area
  * and light_pdf turns that pdf into solid angle, dist^2 / (A cos): MIS
  * weighs a BSDF sample that finds the lamp by it, and with a pdf off by a
- * factor dist (400) the weights of a direction no longer sum to 1. */
+ * factor dist (400) the weights of a direction no longer sum to 1.  And
+ * the first triangle again, one-sided (`sided 1`) and turned to face up,
+ * away from the floor: it lights nothing, whether a path finds it by a
+ * BSDF sample (emitted() must see its back) or by a light sample. */
 static void test_polygon_lights(void)
 {
     static const vec tri[3] = { { -1, -0.5, 1.6 }, { 0.2, 1.3, 1.4 }, { 1.2, -0.9, 1.1 } };
     static const vec quad4[4] = { { -1, -0.8, 1.5 }, { -0.7, 0.9, 1.5 }, { 0.9, 1.1, 1.5 }, { 1.2, -1, 1.5 } };
     static const vec far[3] = { { -30, -20, 400 }, { 2, 24, 400 }, { 32, -18, 400 } };
     static const char *const how[4] = { "bsdf", "nee", "mis", "Whitted's area light" };
-    static const char *const what[4] = {
+    static const char *const what[5] = {
         "a triangle lamp lights a floor as Lambert's polygon formula says",
         "a quad lamp (two triangles) lights a floor as Lambert's polygon formula says",
         "a triangle lamp behind a black square just below it lights nothing",
         "a far triangle lamp (0.008 sr: sampled by area) lights a floor as Lambert's polygon formula says",
+        "a one-sided triangle lamp facing away from the floor lights nothing",
     };
     double Le = 2, rho = 0.7;
     int lamp, e, k;
     char name[200];
-    for (lamp = 0; lamp < 4; lamp++)
+    for (lamp = 0; lamp < 5; lamp++)
         for (e = 0; e < 4; e++) {
             const vec *v = lamp == 1 ? quad4 : lamp == 3 ? far : tri;
             int nv = lamp == 1 ? 4 : 3, light;
@@ -419,6 +423,8 @@ static void test_polygon_lights(void)
             light = material(&s, v3(1, 1, 1), 0, 0, 0, Le, 1, 0);
             s.cull = 1;                      /* `sided 1`: the lamp lights from its front, below */
             if (lamp == 1) quad(&s, v[0], v[1], v[2], v[3], light);
+            else if (lamp == 4)              /* its corners the other way round: its front is up */
+                add_triangle(&s, add_vertex(&s, v[0]), add_vertex(&s, v[2]), add_vertex(&s, v[1]), -1, -1, -1, light);
             else add_triangle(&s, add_vertex(&s, v[0]), add_vertex(&s, v[1]), add_vertex(&s, v[2]), -1, -1, -1, light);
             s.set.depth = 1;                 /* Whitted's: the floor's direct light alone */
             ready(&s, e < 3 ? e : MIS, 0, 2);
@@ -430,7 +436,7 @@ static void test_polygon_lights(void)
                 p = v3(4 * random01(&wk, DIM_PIXEL_X) - 2, 4 * random01(&wk, DIM_PIXEL_Y) - 2, 0);
                 ry.o = v3(p.x, p.y, 0.5), ry.d = v3(0, 0, -1), ry.tmin = 0, ry.skip = -1, ry.time = 0;
                 L = e < 3 ? radiance_along(&s, ry.o, ry.d, &wk) : trace(&s, ry, 1, 1, &wk);
-                E = lamp == 2 ? 0 : lambert_polygon(v, nv, p, v3(0, 0, 1), Le);
+                E = lamp == 2 || lamp == 4 ? 0 : lambert_polygon(v, nv, p, v3(0, 0, 1), Le);
                 stat_add(&st, L.x - rho / PI * E);
                 stat_add(&want, rho / PI * E);
             }
@@ -449,18 +455,25 @@ static void test_polygon_lights(void)
  * and the plane's, from every point looked at: x, y in [-1.5, 1.5]), some
  * 5% less than about the plane's normal straight up.  Light sampling (nee,
  * mis) must weigh its samples by cos to n, as BSDF sampling does by drawing
- * about n.  40000 points, direct light only, within K standard errors. */
+ * about n.  40000 points, direct light only, within K standard errors.
+ * Seen straight down, and from 80 degrees on the side the normals lean
+ * away from, where wo lies below the shading normal's horizon but above
+ * the plane: a Lambert surface looks the same from every side of its
+ * plane's front, and which side a ray comes from is the plane's (ng), not
+ * the shading normal's, whose flip would make the floor a back face. */
 static void test_shading_normals(void)
 {
     static const vec quad4[4] = { { -1, -0.8, 1.5 }, { -0.7, 0.9, 1.5 }, { 0.9, 1.1, 1.5 }, { 1.2, -1, 1.5 } };
     double Le = 2, rho = 0.7, tilt = 20 * PI / 180;
     vec n = v3(sin(tilt), 0, cos(tilt));
-    int e, k;
+    int e, k, view;
     char name[200];
+    for (view = 0; view < 2; view++)
     for (e = 0; e < 3; e++) {
         Scene s;
         Worker wk = worker();
         Stat st = { 0, 0, 0 }, want = { 0, 0, 0 };
+        vec dir = view ? v3(sin(80 * PI / 180), 0, -cos(80 * PI / 180)) : v3(0, 0, -1);
         int floor_mat, a, b, c, d, nn;
         default_scene(&s);
         floor_mat = material(&s, v3(1, 1, 1), rho, 0, 0, 0, 1, 0);
@@ -477,13 +490,14 @@ static void test_shading_normals(void)
             double E;
             start_sample(&wk, &s, k, 4, 0);
             p = v3(3 * random01(&wk, DIM_PIXEL_X) - 1.5, 3 * random01(&wk, DIM_PIXEL_Y) - 1.5, 0);
-            L = radiance_along(&s, v3(p.x, p.y, 0.5), v3(0, 0, -1), &wk);
+            L = radiance_along(&s, sub(p, scale(0.5 / -dir.z, dir)), dir, &wk);
             E = lambert_polygon(quad4, 4, p, n, Le);
             stat_add(&st, L.x - rho / PI * E);
             stat_add(&want, rho / PI * E);
         }
         sprintf(name, "a floor with shading normals tilted 20 degrees under a quad lamp: Lambert's formula"
-                " about the shading normal, %s", est_name[e]);
+                " about the shading normal, %s%s", est_name[e],
+                view ? ", seen from 80 degrees, below the shading normal's horizon (the side is the plane's)" : "");
         report(agrees(&st, 0), name, "mean difference %.2g +- %.2g over %g points, where rho/pi E is %.4g"
                " on average", stat_mean(&st), stat_se(&st), st.n, stat_mean(&want));
         free_scene(&s);
