@@ -151,4 +151,22 @@ if [ "$rc" = 1 ] && cmp -s scenes/ball.obj "$TMP/win/ball.obj" && grep -q 'the m
 then ok "-o BALL.OBJ for mesh.sph, which reads ball.obj: refused (exit 1), the mesh kept"
 else bad "-o BALL.OBJ for mesh.sph: exit $rc; $(ls "$TMP/win" | tr '\n' ' ')"
 fi
+
+# A render split across the two systems: a band by ray.exe, the rest by
+# ./ray, merged by each, is the whole run's bytes (a partial is
+# little-endian integers on both; the provenance names the same version and
+# arithmetic, and the same scene).
+./ray scenes/cornell.sph --pt -s 48x36 -n 6 -o "$TMP/lin/whole.pfm" 2>/dev/null
+./ray scenes/cornell.sph --pt -s 48x36 -n 6 --tile 0/3 -o "$TMP/lin/p0.part" 2>/dev/null
+win scenes/cornell.sph --pt -s 48x36 -n 6 --tile 1/3 -o "$TMP/win/p1.part" 2>/dev/null
+./ray scenes/cornell.sph --pt -s 48x36 -n 6 --tile 2/3 -o "$TMP/lin/p2.part" 2>/dev/null
+./ray --merge "$TMP/lin/merged.pfm" "$TMP/lin/p0.part" "$TMP/win/p1.part" "$TMP/lin/p2.part" 2>/dev/null
+win --merge "$TMP/win/merged.pfm" "$TMP/lin/p0.part" "$TMP/win/p1.part" "$TMP/lin/p2.part" 2>/dev/null
+if [ -s "$TMP/lin/whole.pfm" ] && cmp -s "$TMP/lin/whole.pfm" "$TMP/lin/merged.pfm" \
+   && cmp -s "$TMP/lin/whole.pfm" "$TMP/win/merged.pfm"; then
+  ok "a split render, one tile of three by ray.exe, merged by ./ray and by ray.exe: the whole run's bytes"
+else
+  bad "a split render across the systems: $(cmp "$TMP/lin/whole.pfm" "$TMP/lin/merged.pfm" 2>&1 | head -n 1);" \
+      "$(cmp "$TMP/lin/whole.pfm" "$TMP/win/merged.pfm" 2>&1 | head -n 1)"
+fi
 finish
