@@ -156,8 +156,9 @@ static const char *const est_name[] = { "bsdf", "nee", "mis" };
 static void test_furnace(void)
 {
     static const double albedo[2] = { 0.5, 0.8 };
-    int e, ai, roulette, bounces;
+    int e, ai, roulette, bounces, sampler;
     char name[160];
+    for (sampler = INDEPENDENT; sampler <= SOBOL; sampler++)    /* --sampler: both keep the mean */
     for (ai = 0; ai < 2; ai++)
         for (e = 0; e < 3; e++)
             for (roulette = 1; roulette >= 0; roulette--)
@@ -171,12 +172,14 @@ static void test_furnace(void)
                     add_sphere(&s, v3(1, 2, 3), 2, material(&s, v3(1, 1, 1), a, 0, 0, Le, 1, 0));
                     camera(&s, v3(1, 2, 3), v3(1, 3, 3), v3(0, 0, 1), 90);
                     ready(&s, e, roulette, bounces < 0 ? 0 : bounces + 1);
+                    s.set.sampler = sampler;
                     want = bounces < 0 ? Le / (1 - a) : Le * (1 - pow(a, bounces + 1)) / (1 - a);
                     st = image_samples(&s, 20000, 0);
-                    sprintf(name, "furnace, albedo %.1f, %s, roulette %s, %s: L = %s",
+                    sprintf(name, "furnace, albedo %.1f, %s, roulette %s, %s: L = %s%s",
                             a, est_name[e], roulette ? "on" : "off",
                             bounces < 0 ? "no bound" : bounces == 1 ? "1 bounce" : "3 bounces",
-                            bounces < 0 ? "Le/(1-a)" : "Le(1-a^(N+1))/(1-a)");
+                            bounces < 0 ? "Le/(1-a)" : "Le(1-a^(N+1))/(1-a)",
+                            sampler == SOBOL ? ", --sampler sobol" : "");
                     report(agrees(&st, want), name, "%.6f +- %.6f, want %.6f", stat_mean(&st),
                            stat_se(&st), want);
                     free_scene(&s);
