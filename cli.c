@@ -45,6 +45,9 @@ void usage(FILE *to)
           "  --sampler S  the path tracer's numbers: independent (a hash of the sample\n"
           "             and the dimension; default) or sobol (Owen-scrambled Sobol'\n"
           "             points, pair by pair: less noise for the same samples)\n"
+          "  --light-choice C  how next-event estimation picks one light: importance\n"
+          "             (by what it may bring to the point, down a light tree; default)\n"
+          "             or power (by its power alone)\n"
           "  --seed N   the path tracer's noise, 0 or more (default 0): another N, other\n"
           "             noise\n"
           "  --adaptive E  samples in doubling rounds (from 8; the path tracer's from\n"
@@ -223,6 +226,18 @@ static int sampler_arg(const char *v)
     return 1;
 }
 
+/* --light-choice's rule: 0 importance, 1 power; or exit with the choices. */
+static int light_choice_arg(const char *v)
+{
+    if (!strcmp(v, "importance")) return 0;
+    if (strcmp(v, "power")) {
+        fprintf(stderr, "ray: --light-choice takes importance (what a light may bring to the point)"
+                " or power (its power alone), not %s\n", v);
+        exit(2);
+    }
+    return 1;
+}
+
 /* The path tracer's estimator named by --estimator, or exit with the choices. */
 static int estimator_arg(const char *v)
 {
@@ -356,7 +371,7 @@ int parse_args(int argc, char **argv, Args *a)
 {
     int i;
     memset(a, 0, sizeof *a);
-    a->integrator = a->estimator = a->sampler = -1;
+    a->integrator = a->estimator = a->sampler = a->light_choice = -1;
     a->roulette = 1;
     a->seed = -1;
     for (i = 1; i < argc; i++) {
@@ -382,6 +397,7 @@ int parse_args(int argc, char **argv, Args *a)
         else if ((v = option_value(argc, argv, &i, "--estimator"))) a->estimator = estimator_arg(v);
         else if ((v = option_value(argc, argv, &i, "--adaptive"))) a->adaptive = steps_arg("--adaptive", v);
         else if ((v = option_value(argc, argv, &i, "--sampler"))) a->sampler = sampler_arg(v);
+        else if ((v = option_value(argc, argv, &i, "--light-choice"))) a->light_choice = light_choice_arg(v);
         else if ((v = option_value(argc, argv, &i, "--crop"))) split_arg(a, "--crop", v);
         else if ((v = option_value(argc, argv, &i, "--tile"))) split_arg(a, "--tile", v);
         else if ((v = option_value(argc, argv, &i, "--samples"))) split_arg(a, "--samples", v);

@@ -104,7 +104,8 @@
  *       bsdf_at()         the BSDF at the hit
  *     ^ sample_light()    next-event estimation
  *     ^ bounce_random()   this bounce's numbers                     samples
- *       choose_light()    a light, by its power                     Kajiya
+ *       choose_light()    a light, by what it may bring here        Kajiya
+ *       node_weight(), importance()   down the light tree
  *       sample_emitter()  a point on it
  *       triangle_light_sample()  on the lamp's triangle             the primitives
  *       spherical_triangle()     as seen from the point
@@ -244,6 +245,7 @@ typedef struct {
     int srgb;                 /* the bytes go through the sRGB curve (for adaptive's rule) */
     int no_skip;              /* --no-skip: no work skipped that the plain algorithm does */
     int sampler;              /* the path tracer's numbers: INDEPENDENT or SOBOL (--sampler) */
+    int light_choice;         /* how sample_light picks a light: BY_IMPORTANCE or BY_POWER */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
     int x0, y0, x1, y1;       /* the pixels rendered, x0 <= x < x1, y0 <= y < y1: the whole
                                * image, or a part of it (--crop, --tile) */
@@ -251,11 +253,29 @@ typedef struct {
     const char *accel_line;   /* the scene's `accel NAME` line, or NULL */
 } Settings;
 
-/* The path tracer's lights, each chosen in proportion to its power. */
+/* A node of the light tree (prepare_lights): what every light below it
+ * shares, bounded so that importance() can say what they may bring to a
+ * point.  A leaf holds one light. */
+typedef struct {
+    vec lo, hi;               /* a box holding them (swept, if they move), */
+    vec centre; real r2;      /* and the sphere about it (sphere_of_box) */
+    vec axis;                 /* every normal lies within theta_o of the axis */
+    real cos_o, sin_o;        /* theta_o (pi: any direction) */
+    real cos_e;               /* and each emits within theta_e of its normal */
+    int two_sided;            /* 1: some emit from both sides of their normal */
+    real power;               /* their power (luminance), together */
+    int child[2];             /* the two halves, or -1 for a leaf */
+    int parent, light;        /* its parent (-1: the root); a leaf's light */
+} LightNode;
+
+/* The path tracer's lights, and how sample_light chooses one: the sky
+ * half the time (when there are others), else down the light tree. */
 typedef struct {
     Emitter *emit;  int nemit;
     int sky;                  /* the sky's light, or -1 */
-    real *emit_cdf;           /* emit_cdf[i]: chance of choosing one of lights 0..i */
+    LightNode *node;          /* the light tree of every light but the sky: */
+    int nnode, root;          /* node[root] its root (-1: no such light) */
+    int *leaf;                /* leaf[l]: light l's node */
     int *emitter;             /* emitter[object]: its light, or -1 */
 } Lights;
 
@@ -307,6 +327,7 @@ enum { WHITTED, PATH };
 enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
 enum { BSDF_ONLY, NEE, MIS };
 enum { INDEPENDENT, SOBOL };
+enum { BY_IMPORTANCE, BY_POWER };
 
 /* Objects are numbered spheres first, then cones, then triangles. */
 enum { SPHERE, CONE, TRIANGLE };
@@ -517,8 +538,15 @@ static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
 static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Worker *wk);
 static void prepare_lights(Scene *s);
-static int choose_light(const Scene *s, real u);
-static real light_choice(const Scene *s, int l);
+static int light_tree(Lights *L, int *order, int n, int parent);
+static void split_lights(const Lights *L, int *order, int n, int m, int a);
+static void bound_lights(LightNode *k, const LightNode *a, const LightNode *b);
+static void sphere_of_box(LightNode *k);
+static real coordinate(vec v, int a);
+static real importance(const LightNode *k, vec x, vec n);
+static real node_weight(const Scene *s, int k, vec x, vec n);
+static int choose_light(const Scene *s, vec x, vec n, real u, real *chance);
+static real light_choice(const Scene *s, int l, vec x, vec n);
 static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u, real v,
                           vec *wi, real *dist, vec *Le, real *pdf);
 static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist, Worker *wk);
@@ -1697,12 +1725,13 @@ static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Wor
 {
     vec wi, Le, f;
     real dist, pdf, cosi;
-    int l = choose_light(s, bounce_random(wk, LIGHT_CHOICE)), delta;
+    real chance;
+    int l = choose_light(s, h->p, b->n, bounce_random(wk, LIGHT_CHOICE), &chance), delta;
     if (l < 0) return v3(0, 0, 0);
     delta = sample_emitter(s, l, h->p, b->n, h->time, bounce_random(wk, LIGHT_U),
                            bounce_random(wk, LIGHT_V), &wi, &dist, &Le, &pdf);
     if (!(pdf > 0)) return v3(0, 0, 0);
-    pdf *= light_choice(s, l);
+    pdf *= chance;
     cosi = dot(wi, b->n);
     f = bsdf_eval(b, wo, wi);
     if (!(cosi > 0) || (f.x == 0 && f.y == 0 && f.z == 0)) return v3(0, 0, 0);
@@ -1726,45 +1755,70 @@ static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist,
 static real luminance(vec c) { return (real)0.2126 * c.x + (real)0.7152 * c.y + (real)0.0722 * c.z; }
 
 /* One more light, of the given power, at the end of the list (room for
- * it was made by prepare_lights). */
-static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, real power,
-                        double *total)
+ * it was made by prepare_lights), and its leaf of the light tree, made
+ * here and put in place by light_tree(): its box, and the cone of its
+ * normals (a point light and a sphere: any direction; a triangle: its
+ * front normal, and its back too unless it is one-sided). */
+static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, real power)
 {
-    s->lights.emit[s->lights.nemit].type = type;
-    s->lights.emit[s->lights.nemit].obj = obj;
-    s->lights.emit[s->lights.nemit].pos = pos;
-    s->lights.emit[s->lights.nemit].intensity = intensity;
-    *total += power;
-    s->lights.emit_cdf[s->lights.nemit++] = (real)*total;
-    if (obj >= 0) s->lights.emitter[obj] = s->lights.nemit - 1;
+    Lights *L = &s->lights;
+    LightNode *leaf = &L->node[L->nemit];
+    L->emit[L->nemit].type = type;
+    L->emit[L->nemit].obj = obj;
+    L->emit[L->nemit].pos = pos;
+    L->emit[L->nemit].intensity = intensity;
+    if (obj >= 0) L->emitter[obj] = L->nemit;
+    L->nemit++;
+    if (type == SKY_LIGHT) return;
+    memset(leaf, 0, sizeof *leaf);
+    leaf->lo = leaf->hi = pos;
+    if (obj >= 0) {
+        double lo[3], hi[3];
+        prim_bounds(s, obj, lo, hi);
+        leaf->lo = v3((real)lo[0], (real)lo[1], (real)lo[2]);
+        leaf->hi = v3((real)hi[0], (real)hi[1], (real)hi[2]);
+    }
+    leaf->axis = v3(0, 0, 1), leaf->cos_o = -1, leaf->sin_o = 0;
+    if (type == TRIANGLE_LIGHT) {
+        const Triangle *tr = &s->tri[obj - s->nsph - s->ncone];
+        leaf->axis = unit(cross(tr->e1, tr->e2)), leaf->cos_o = 1;
+        leaf->two_sided = !tr->cull;
+    }
+    leaf->cos_e = 0;                                  /* a lambertian emitter's pi / 2 */
+    leaf->power = power;
+    leaf->child[0] = leaf->child[1] = -1;
+    sphere_of_box(leaf);
 }
 
-/* The path tracer's lights, each with its power, so that sample_light can
- * choose one in proportion to it: point lights (intensity I: power 4 pi I),
- * emitting spheres and triangles (radiance Le over area A, each side:
- * pi Le A).  A background that is not black is the sky, whose power has no
- * finite measure: it is chosen half the time when there are other lights
- * (pricing it by a sphere about the scene, as pbrt does, starves a small
- * lamp on a large floor of shadow rays). */
+/* The path tracer's lights, each with its power: point lights (intensity
+ * I: power 4 pi I), emitting spheres and triangles (radiance Le over area
+ * A, each side: pi Le A), then the light tree over them.  A background
+ * that is not black is the sky, whose power has no finite measure: it is
+ * chosen half the time when there are other lights (pricing it by a
+ * sphere about the scene, as pbrt does, starves a small lamp on a large
+ * floor of shadow rays). */
 static void prepare_lights(Scene *s)
 {
-    double total = 0;
-    int i, k, n = nobj(s);
+    Lights *L = &s->lights;
+    int i, k, n = nobj(s), *order;
     size_t most = (size_t)s->nlight + n + 1;      /* point lights, objects, the sky */
-    free(s->lights.emitter);                       /* made again, if made before */
-    free(s->lights.emit);
-    free(s->lights.emit_cdf);
-    s->lights.emitter = malloc(((size_t)n + 1) * sizeof *s->lights.emitter);
-    s->lights.emit = malloc(most * sizeof *s->lights.emit);
-    s->lights.emit_cdf = malloc(most * sizeof *s->lights.emit_cdf);
-    if (!s->lights.emitter || !s->lights.emit || !s->lights.emit_cdf) out_of_memory();
-    s->lights.nemit = 0;
-    for (i = 0; i < n; i++) s->lights.emitter[i] = -1;
-    s->lights.sky = -1;
+    free(L->emitter);                             /* made again, if made before */
+    free(L->emit);
+    free(L->node);
+    free(L->leaf);
+    L->emitter = malloc(((size_t)n + 1) * sizeof *L->emitter);
+    L->emit = malloc(most * sizeof *L->emit);
+    L->node = malloc(2 * most * sizeof *L->node);
+    L->leaf = malloc(most * sizeof *L->leaf);
+    order = malloc(most * sizeof *order);
+    if (!L->emitter || !L->emit || !L->node || !L->leaf || !order) out_of_memory();
+    L->nemit = 0;
+    for (i = 0; i < n; i++) L->emitter[i] = -1;
+    L->sky = -1;
     for (i = 0; i < s->nlight; i++)
         if (s->light[i].sphere < 0)
             add_emitter(s, POINT_LIGHT, -1, s->light[i].pos, s->light[i].color,
-                        4 * (real)PI * luminance(s->light[i].color), &total);
+                        4 * (real)PI * luminance(s->light[i].color));
     for (i = 0; i < n; i++) {
         const Material *m;
         int what = kind(s, i, &k);
@@ -1778,34 +1832,192 @@ static void prepare_lights(Scene *s)
             area = sqrt(dot(c, c)) / 2 * (s->tri[k].cull ? 1 : 2);
         }
         add_emitter(s, what == SPHERE ? SPHERE_LIGHT : TRIANGLE_LIGHT, i, v3(0, 0, 0),
-                    v3(0, 0, 0), (real)PI * m->kl * luminance(m->color) * area, &total);
+                    v3(0, 0, 0), (real)PI * m->kl * luminance(m->color) * area);
     }
+    for (i = 0; i < L->nemit; i++) order[i] = i;
+    L->nnode = L->nemit;                                 /* the leaves, then the inner nodes */
+    L->root = L->nemit > 0 ? light_tree(L, order, L->nemit, -1) : -1;
+    free(order);
     if (luminance(s->background) > 0) {
         s->lights.sky = s->lights.nemit;
-        add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), total > 0 ? (real)total : 1,
-                    &total);
+        add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), 0);
     }
-    for (i = 0; i < s->lights.nemit; i++) s->lights.emit_cdf[i] = total > 0 ? s->lights.emit_cdf[i] / (real)total : 0;
-    if (s->lights.nemit > 0) s->lights.emit_cdf[s->lights.nemit - 1] = 1;
 }
 
-/* The light whose share of the total power holds u, or -1 without lights. */
-static int choose_light(const Scene *s, real u)
+/* The light tree over lights order[0..n-1] below the given parent: its
+ * root's node.  Split in two halves by count, across the widest spread of
+ * their boxes' centres, so it is at most log2 n + 1 deep; each inner node
+ * bounds its halves'. */
+static int light_tree(Lights *L, int *order, int n, int parent)
 {
-    int lo = 0, hi = s->lights.nemit - 1;
-    if (s->lights.nemit == 0) return -1;
-    while (lo < hi) {               /* the first light whose cdf exceeds u */
-        int mid = (lo + hi) / 2;
-        if (s->lights.emit_cdf[mid] > u) hi = mid;
-        else lo = mid + 1;
+    LightNode *in;
+    int k, half = n / 2, a = 0;
+    vec lo, hi;
+    if (n == 1) {
+        k = order[0];
+        L->node[k].parent = parent, L->node[k].light = k;
+        L->leaf[k] = k;
+        return k;
     }
-    return lo;
+    k = L->nnode++;
+    lo = hi = L->node[order[0]].centre;
+    for (a = 1; a < n; a++) {
+        vec c = L->node[order[a]].centre;
+        lo = v3(fmin(lo.x, c.x), fmin(lo.y, c.y), fmin(lo.z, c.z));
+        hi = v3(fmax(hi.x, c.x), fmax(hi.y, c.y), fmax(hi.z, c.z));
+    }
+    hi = sub(hi, lo);
+    a = hi.x >= hi.y && hi.x >= hi.z ? 0 : hi.y >= hi.z ? 1 : 2;
+    split_lights(L, order, n, half, a);
+    in = &L->node[k];
+    in->parent = parent, in->light = -1;
+    in->child[0] = light_tree(L, order, half, k);
+    in->child[1] = light_tree(L, order + half, n - half, k);
+    bound_lights(in, &L->node[in->child[0]], &L->node[in->child[1]]);
+    return k;
 }
 
-/* The chance that choose_light picks light l. */
-static real light_choice(const Scene *s, int l)
+/* A node's bounding sphere: of its box, the centre and half the diagonal. */
+static void sphere_of_box(LightNode *k)
 {
-    return s->lights.emit_cdf[l] - (l > 0 ? s->lights.emit_cdf[l - 1] : 0);
+    vec diag = sub(k->hi, k->lo);
+    k->centre = scale((real)0.5, add(k->lo, k->hi));
+    k->r2 = dot(diag, diag) / 4;
+}
+
+/* Coordinate a (0, 1, 2: x, y, z) of v. */
+static real coordinate(vec v, int a) { return a == 0 ? v.x : a == 1 ? v.y : v.z; }
+
+/* Reorders order[0..n-1] so that the lights before place m have centres
+ * no further along axis a than those from m on (Hoare's FIND, 1961). */
+static void split_lights(const Lights *L, int *order, int n, int m, int a)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        real pivot = coordinate(L->node[order[(lo + hi) / 2]].centre, a);
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (coordinate(L->node[order[i]].centre, a) < pivot) i++;
+            while (coordinate(L->node[order[j]].centre, a) > pivot) j--;
+            if (i <= j) { int t = order[i]; order[i++] = order[j]; order[j--] = t; }
+        }
+        if (m <= j) hi = j;
+        else if (m >= i) lo = i;
+        else break;
+    }
+}
+
+/* Node k bounds nodes a and b: a box holding both boxes, a cone holding
+ * both cones of normals (the smallest, when one does not hold the other:
+ * its half-angle the mean of theirs and the angle between their axes, as
+ * Conty Estevez and Kulla 2018 bound a union), the wider spread, and the
+ * power of both. */
+static void bound_lights(LightNode *k, const LightNode *a, const LightNode *b)
+{
+    real ta, tb, td, t;
+    vec lo = a->lo, hi = a->hi, perp;
+    k->lo = v3(fmin(lo.x, b->lo.x), fmin(lo.y, b->lo.y), fmin(lo.z, b->lo.z));
+    k->hi = v3(fmax(hi.x, b->hi.x), fmax(hi.y, b->hi.y), fmax(hi.z, b->hi.z));
+    sphere_of_box(k);
+    k->power = a->power + b->power;
+    k->two_sided = a->two_sided || b->two_sided;
+    k->cos_e = fmin(a->cos_e, b->cos_e);
+    if (a->cos_o > b->cos_o) { const LightNode *w = a; a = b; b = w; }   /* a: the wider */
+    ta = acos(a->cos_o), tb = acos(b->cos_o);
+    td = acos(fmax(-1, fmin(1, dot(a->axis, b->axis))));
+    k->axis = a->axis, k->cos_o = a->cos_o, k->sin_o = a->sin_o;
+    if (td + tb <= ta) return;                          /* a holds b */
+    t = (ta + td + tb) / 2;
+    perp = comb(-cos(td), a->axis, b->axis);            /* towards b, at right angles to a */
+    if (t >= PI || !(dot(perp, perp) > 0)) { k->cos_o = -1, k->sin_o = 0; return; }
+    perp = unit(perp);
+    k->axis = unit(add(scale(cos(t - ta), a->axis), scale(sin(t - ta), perp)));
+    k->cos_o = cos(t), k->sin_o = sin(t);
+}
+
+/* What the lights below node k may bring to the point x of normal n:
+ * their power over the squared distance, times the cosine at each end as
+ * large as any light within the box could make it (Conty Estevez and
+ * Kulla 2018, eq. 3: the box seen from x as its bounding sphere, of
+ * half-angle theta_b; the light's end within theta_o + theta_b of the
+ * axis costs nothing, the point's end within theta_b of its normal).  It
+ * is 0 only when no light below can send anything to x from above its
+ * tangent plane, so choosing by it misses nothing next-event estimation
+ * could have found.  The distance is to the box's centre, but no less
+ * than a quarter of the sphere's radius: near the middle of a wide group
+ * of lights it would otherwise outweigh its sibling on no evidence. */
+static real importance(const LightNode *k, vec x, vec n)
+{
+    vec d = sub(x, k->centre);
+    real d2 = dot(d, d), near = d2 > k->r2 / 16 ? d2 : k->r2 / 16, sin2_b, cos_b, cos_i;
+    real cos_l = 1, cos_s = 1;
+    if (!(near > 0)) return k->power;                   /* a point light at x */
+    if (d2 <= k->r2) return k->power / near;            /* x in the sphere: no bound */
+    sin2_b = k->r2 / d2, cos_b = sqrt(1 - sin2_b);
+    d = scale(1 / sqrt(d2), d);                         /* from the lights to x */
+    if (k->cos_o > -cos_b) {                            /* theta_o + theta_b < pi */
+        real cos_ob = k->cos_o * cos_b - k->sin_o * sqrt(sin2_b), cos_w = dot(k->axis, d);
+        if (k->two_sided) cos_w = fabs(cos_w);
+        if (cos_w < cos_ob) cos_l = cos_w * cos_ob + sqrt(fmax(0, (1 - cos_w * cos_w) * (1 - cos_ob * cos_ob)));
+        if (cos_l <= k->cos_e) return 0;                /* x lies behind every light */
+    }
+    cos_i = -dot(n, d);
+    if (cos_i < cos_b) cos_s = cos_i * cos_b + sqrt(fmax(0, (1 - cos_i * cos_i) * sin2_b));
+    if (cos_s <= 0) return 0;                           /* every light lies below x's horizon */
+    return k->power * cos_l * cos_s / near;
+}
+
+/* How much sample_light favours the lights below node k at x: what they
+ * may bring there, or (--light-choice power) their power alone. */
+static real node_weight(const Scene *s, int k, vec x, vec n)
+{
+    const LightNode *node = &s->lights.node[k];
+    return s->set.light_choice == BY_POWER ? node->power : importance(node, x, n);
+}
+
+/* A light for the point x of normal n, chosen by the number u, and the
+ * chance of choosing it; -1 when none can light x.  The sky half the
+ * time when there are other lights; else down the tree, at each node one
+ * half by its weight against the other's, the rest of u choosing on.  A
+ * node whose bound let it be chosen may find both halves weigh 0: that
+ * draw finds no light, so the chances add up to less than 1, but no light
+ * that could reach x is ever left out, and the estimate stays unbiased. */
+static int choose_light(const Scene *s, vec x, vec n, real u, real *chance)
+{
+    const Lights *L = &s->lights;
+    int k = L->root;
+    *chance = 1;
+    if (L->sky >= 0 && (k < 0 || u < (real)0.5)) {
+        *chance = k < 0 ? 1 : (real)0.5;
+        return L->sky;
+    }
+    if (k < 0) return -1;
+    if (L->sky >= 0) u = 2 * u - 1, *chance = (real)0.5;
+    while (L->node[k].light < 0) {
+        const int *c = L->node[k].child;
+        real a = node_weight(s, c[0], x, n), b = node_weight(s, c[1], x, n), p = a / (a + b);
+        if (!(a + b > 0)) return -1;
+        if (u < p || !(b > 0)) u = fmin(u / p, 1), *chance *= a / (a + b), k = c[0];
+        else u = fmin((u - p) / (1 - p), 1), *chance *= b / (a + b), k = c[1];
+    }
+    return L->node[k].light;
+}
+
+/* The chance that choose_light picks light l at x, of normal n: the
+ * same weights, from l's leaf up to the root. */
+static real light_choice(const Scene *s, int l, vec x, vec n)
+{
+    const Lights *L = &s->lights;
+    real chance = L->sky >= 0 && L->root >= 0 ? (real)0.5 : 1;
+    int k, up;
+    if (l == L->sky) return chance;
+    for (k = L->leaf[l]; (up = L->node[k].parent) >= 0; k = up) {
+        const int *c = L->node[up].child;
+        real a = node_weight(s, c[0], x, n), b = node_weight(s, c[1], x, n);
+        if (!(a + b > 0)) return 0;
+        chance *= (k == c[0] ? a : b) / (a + b);
+    }
+    return chance;
 }
 
 /* A direction wi from x towards a point of light l chosen by the numbers
@@ -1862,17 +2074,17 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u
 static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny, real time)
 {
     const Emitter *e = &s->lights.emit[l];
+    real chance = light_choice(s, l, x, n), dist;   /* where x is: the tree's lights are swept */
     vec d;
-    real dist;
     int k;
-    if (e->type == SKY_LIGHT) return light_choice(s, l) * cosine_hemisphere_pdf(dot(y, n));
+    if (e->type == SKY_LIGHT) return chance * cosine_hemisphere_pdf(dot(y, n));
     kind(s, e->obj, &k);
     x = rest_frame(s, e->obj, time, x);
     y = rest_frame(s, e->obj, time, y);
-    if (e->type == SPHERE_LIGHT) return light_choice(s, l) * sphere_pdf(&s->sph[k], x, y);
+    if (e->type == SPHERE_LIGHT) return chance * sphere_pdf(&s->sph[k], x, y);
     d = sub(y, x);
     dist = sqrt(dot(d, d));
-    return light_choice(s, l) * triangle_light_pdf(&s->tri[k], x, dist, dot(d, ny) / dist);
+    return chance * triangle_light_pdf(&s->tri[k], x, dist, dot(d, ny) / dist);
 }
 
 /* Whether object i, with front normal ng, emits towards wo: a one-sided
@@ -3434,10 +3646,11 @@ static int start_partial(const Scene *s, const Options *o, int spp, Partial *p)
     p->s0 = s->set.s0, p->s1 = s->set.s0 + o->spp;
     p->srgb = s->set.srgb;
     sprintf(p->about, "version %s\nscene %016llx\nrenderer %s\ndepth %d\nmax_rays %d\nestimator %d\n"
-            "roulette %d\nseed %u\nadaptive %.17g\nno_skip %d\nsampler %d\n", program_version(),
+            "roulette %d\nseed %u\nadaptive %.17g\nno_skip %d\nsampler %d\nlight_choice %d\n",
+            program_version(),
             (unsigned long long)scene_hash(s), s->set.integrator == PATH ? "path" : "whitted", s->set.depth,
             s->set.max_rays, s->set.estimator, s->set.roulette, s->set.seed, (double)s->set.adaptive,
-            s->set.no_skip, s->set.sampler);
+            s->set.no_skip, s->set.sampler, s->set.light_choice);
     return new_partial(p);
 }
 
@@ -3784,7 +3997,7 @@ static void free_scene(Scene *s)
     if (s->accel.grid) grid_free(s->accel.grid);
     free(s->mat); free(s->sph); free(s->cone); free(s->tri);
     free(s->vert); free(s->norm); free(s->light);
-    free(s->lights.emit); free(s->lights.emit_cdf); free(s->lights.emitter);
+    free(s->lights.emit); free(s->lights.node); free(s->lights.leaf); free(s->lights.emitter);
 }
 
 /* Why the picture will come out black, or NULL: nothing lights the
@@ -4018,6 +4231,7 @@ int main(int argc, char **argv)
     if (a.depth) s.set.depth = s.set.max_rays = a.depth;
     s.set.no_skip = a.no_skip;
     if (a.sampler >= 0) s.set.sampler = a.sampler;
+    if (a.light_choice >= 0) s.set.light_choice = a.light_choice;
     accel = a.accel ? a.accel : s.set.accel_line ? s.set.accel_line : "auto";
     if (ok && !settle_path_options(&s, a.integrator, a.estimator, a.roulette, a.seed)) {
         free_scene(&s); free_args(&a);

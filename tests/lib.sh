@@ -13,3 +13,13 @@ CFLAGS=${CFLAGS:--O2}
 RAY_PARTS=${RAY_PARTS:-scene.c image.c cli.c kdtree.c bvh.c grid.c}
 export TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
+# Python that reads a PFM's floats, for the tests' checkers: pfm(name) is
+# the list of every pixel's r, g, b (python3 -c "$PFM_PY ...").
+PFM_PY='
+import sys, struct
+def pfm(name):
+    d = open(name, "rb").read()
+    head = d.split(b"\n", 3)
+    w, h = map(int, head[1].split())
+    return struct.unpack("<%df" % (3 * w * h), head[3][:12 * w * h])
+'

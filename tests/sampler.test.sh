@@ -12,20 +12,12 @@
 $CC $CFLAGS -std=c99 -o "$TMP/test_sampler" tests/test_sampler.c $RAY_PARTS -lm || { bad "tests/test_sampler.c compiles"; exit 1; }
 "$TMP/test_sampler"
 
-pfm_py='
-import sys, struct
-def pfm(name):
-    d = open(name, "rb").read()
-    head = d.split(b"\n", 3)
-    w, h = map(int, head[1].split())
-    return struct.unpack("<%df" % (3 * w * h), head[3][:12 * w * h])
-'
 for r in "cornell.sph -n 16" "veach.sph -n 16" "caustic.sph -n 16" "lamp.sph -n 16" "dof.sph --pt -n 8"; do
   set -- $r
   f=$1; shift
   ./ray scenes/$f --pt "$@" -s 48x36 --sampler independent -o "$TMP/i.pfm" 2>/dev/null
   ./ray scenes/$f --pt "$@" -s 48x36 --sampler sobol --seed 7 -o "$TMP/s.pfm" 2>/dev/null
-  z=$(python3 -c "$pfm_py
+  z=$(python3 -c "$PFM_PY
 a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
 d = [sum(b[3 * k:3 * k + 3]) - sum(a[3 * k:3 * k + 3]) for k in range(len(a) // 3)]   # per pixel
 n = len(d); m = sum(d) / n; v = sum((x - m) ** 2 for x in d) / (n - 1)
@@ -38,7 +30,7 @@ done
 noise() {   # the sampler's noise on lamp.sph at 64 spp: RMSE between seeds 1 and 2, over sqrt 2
   ./ray scenes/lamp.sph -s 48x36 -n 64 --sampler "$1" --seed 1 -o "$TMP/n1.pfm" 2>/dev/null
   ./ray scenes/lamp.sph -s 48x36 -n 64 --sampler "$1" --seed 2 -o "$TMP/n2.pfm" 2>/dev/null
-  python3 -c "$pfm_py
+  python3 -c "$PFM_PY
 a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
 print('%.5f' % ((sum((x - y) ** 2 for x, y in zip(a, b)) / len(a) / 2) ** 0.5))" "$TMP/n1.pfm" "$TMP/n2.pfm"
 }

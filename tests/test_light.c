@@ -13,6 +13,18 @@
  *  - the pdf sample_emitter gives with a direction is the one light_pdf
  *    finds for the point it leads to (MIS needs the two to agree), on both
  *    sides of SOLID_ANGLE_FROM, for the Cornell box's lamp.
+ * And the light tree that chooses among many lights (prepare_lights,
+ * choose_light, light_choice), on scenes/lights100.sph and on a scene of
+ * random point lights, glowing spheres and one- and two-sided triangles,
+ * some moving, with and without a sky:
+ *  - every node bounds its children: box, cone of normals, spread, power;
+ *  - at any point the chances of all the lights add up to 1 (or to the
+ *    sky's, where no other light can reach), choose_light's chance is
+ *    light_choice's, and the lights it picks come in those proportions
+ *    (chi-square, per point);
+ *  - a light given chance 0 at a point cannot light it: no point of it,
+ *    at any time the shutter is open, lies above the point's tangent
+ *    plane and sends light towards it.
  * Random triangles and points, fixed seeds. */
 #define main ray_main
 #include "../ray.c"
@@ -142,7 +154,7 @@ static void test_pdf_agrees(void)
         {
             const Triangle *t = &s.tri[s.lights.emit[l].obj - s.nsph - s.ncone];
             vec y = comb(dist, wi, p), ny = unit(cross(t->e1, t->e2));
-            double q = light_pdf(&s, l, p, n, y, ny, 0) / light_choice(&s, l);
+            double q = light_pdf(&s, l, p, n, y, ny, 0) / light_choice(&s, l, p, n);
             if (fabs(q / pdf - 1) > worst) worst = fabs(q / pdf - 1);
             if (spherical_triangle(t, p, c, angle) >= SOLID_ANGLE_FROM) solid++;
             else area++;
@@ -185,8 +197,169 @@ static void test_pdf_agrees(void)
     free_scene(&s);
 }
 
-int main(void)
+/* A scene of random lights of every kind the tree holds, into file. */
+static int write_random_lights(const char *file, int sky, unsigned long long x)
 {
+    FILE *f = fopen(file, "w");
+    int i;
+    if (!f) return 0;
+    fprintf(f, "integrator path\nbackground %s\nshutter 0 1\n", sky ? ".2 .3 .4" : "0 0 0");
+    fprintf(f, "tri -20 -20 0  20 -20 0  20 20 0  .8 .8 .8 .8 0 0 0 1\n");
+    for (i = 0; i < 10; i++)
+        fprintf(f, "light %.3f %.3f %.3f  %.3f .5 .5\n", 16 * rnd(&x) - 8, 16 * rnd(&x) - 8, 8 * rnd(&x), 2 * rnd(&x));
+    for (i = 0; i < 60; i++) {
+        double c[3] = { 16 * rnd(&x) - 8, 16 * rnd(&x) - 8, 1 + 7 * rnd(&x) }, r = 0.05 + 0.8 * rnd(&x);
+        if (i == 20) fprintf(f, "sided 1\n");
+        fprintf(f, "move %.3f %.3f %.3f\n", i % 3 ? 0 : 4 * rnd(&x) - 2, i % 3 ? 0 : 4 * rnd(&x) - 2, 0.0);
+        if (i % 4 == 0)
+            fprintf(f, "%.3f %.3f %.3f  1 1 1  %.3f  0 0 0 %.3f 1\n", c[0], c[1], c[2], r, 0.1 + 5 * rnd(&x));
+        else
+            fprintf(f, "tri %.3f %.3f %.3f  %.3f %.3f %.3f  %.3f %.3f %.3f  1 1 1 0 0 0 %.3f 1\n",
+                    c[0], c[1], c[2], c[0] + 2 * r * (rnd(&x) - .5), c[1] + 2 * r * (rnd(&x) - .5),
+                    c[2] + 2 * r * (rnd(&x) - .5), c[0] + 2 * r * (rnd(&x) - .5), c[1] + 2 * r * (rnd(&x) - .5),
+                    c[2] + 2 * r * (rnd(&x) - .5), 0.1 + 5 * rnd(&x));
+    }
+    return fclose(f) == 0;
+}
+
+/* Whether every node of the light tree bounds its children; the tree's
+ * depth into *depth. */
+static int tree_bounds(const Scene *s, int k, int *depth)
+{
+    const LightNode *n = &s->lights.node[k];
+    int i, d[2];
+    if (n->light >= 0) return *depth = 1, n->child[0] < 0 && s->lights.leaf[n->light] == k;
+    for (i = 0; i < 2; i++) {
+        const LightNode *c = &s->lights.node[n->child[i]];
+        double angle = acos(fmax(-1, fmin(1, dot(n->axis, c->axis)))) + acos(c->cos_o);
+        if (c->parent != k || !tree_bounds(s, n->child[i], &d[i])) return 0;
+        if (c->lo.x < n->lo.x || c->lo.y < n->lo.y || c->lo.z < n->lo.z || c->hi.x > n->hi.x
+            || c->hi.y > n->hi.y || c->hi.z > n->hi.z) return 0;
+        if (n->cos_o > -1 && angle > acos(n->cos_o) + 1e-9) return 0;   /* the child's cone within */
+        if (c->two_sided > n->two_sided || c->cos_e < n->cos_e) return 0;
+    }
+    *depth = 1 + (d[0] > d[1] ? d[0] : d[1]);
+    return fabs(n->power - s->lights.node[n->child[0]].power - s->lights.node[n->child[1]].power)
+           <= 1e-12 * n->power;
+}
+
+/* A point of light l at the given time, chosen by u and v, and its normal
+ * there (0 for a point light). */
+static vec point_on_light(const Scene *s, int l, double time, double u, double v, vec *ny)
+{
+    const Emitter *e = &s->lights.emit[l];
+    vec y;
+    int k;
+    *ny = v3(0, 0, 0);
+    if (e->type == POINT_LIGHT) return e->pos;
+    kind(s, e->obj, &k);
+    if (e->type == SPHERE_LIGHT) {
+        double z = 1 - 2 * u, r = sqrt(fmax(0, 1 - z * z));
+        *ny = v3(r * cos(2 * PI * v), r * sin(2 * PI * v), z);
+        y = comb(s->sph[k].rad, *ny, s->sph[k].cen);
+    } else {
+        const Triangle *t = &s->tri[k];
+        if (u + v > 1) u = 1 - u, v = 1 - v;
+        y = add(t->v0, add(scale(u, t->e1), scale(v, t->e2)));
+        *ny = unit(cross(t->e1, t->e2));
+    }
+    return moves(s, e->obj) ? comb(time, velocity(s, e->obj), y) : y;
+}
+
+/* Whether light l can send light to x, of normal n, from above x's
+ * tangent plane: by 400 of its points at 4 times the shutter is open. */
+static int can_light(const Scene *s, int l, vec x, vec n, unsigned long long *r)
+{
+    int i;
+    for (i = 0; i < 1600; i++) {
+        vec ny, y = point_on_light(s, l, (i % 4) / 3.0, rnd(r), rnd(r), &ny), d = sub(x, y);
+        int front = s->lights.emit[l].type != TRIANGLE_LIGHT || !s->tri[s->lights.emit[l].obj - s->nsph - s->ncone].cull;
+        if (dot(n, d) < 0 && (dot(ny, d) > 0 || (front && s->lights.emit[l].type == TRIANGLE_LIGHT)
+                              || s->lights.emit[l].type == POINT_LIGHT))
+            return 1;
+    }
+    return 0;
+}
+
+/* The light tree of one scene, against the list above. */
+static void test_tree(const char *file, const char *name, vec lo, vec hi)
+{
+    Scene s;
+    unsigned long long x = 77;
+    double worst_sum = 0, worst_chance = 0, worst_z = -1e9;
+    int k, depth = 0, unreached = 0, zeros = 0, points = 0;
+    if (!load_scene(&s, file) || !settle_path_options(&s, PATH, -1, 1, 0) || s.lights.root < 0) {
+        report(0, "the light tree", "%s did not load, or has no lights", name);
+        return;
+    }
+    k = tree_bounds(&s, s.lights.root, &depth);
+    report(k && depth <= 2 + (int)ceil(log2(s.lights.nemit)),
+           "the light tree: every node bounds its children (box, cone of normals, spread, power)",
+           "%s: %d lights, %d deep", name, s.lights.nemit, depth);
+    for (k = 0; k < 3000; k++) {
+        vec p = v3(lo.x + (hi.x - lo.x) * rnd(&x), lo.y + (hi.y - lo.y) * rnd(&x), lo.z + (hi.z - lo.z) * rnd(&x));
+        vec n = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5));
+        double sum = 0, want;
+        int l, any = 0;
+        for (l = 0; l < s.lights.nemit; l++) {
+            double c = light_choice(&s, l, p, n);
+            sum += c;
+            if (l != s.lights.sky && c > 0) any = 1;
+            if (l != s.lights.sky && !(c > 0) && k % 10 == 0) {
+                zeros++;
+                unreached += can_light(&s, l, p, n, &x);
+            }
+        }
+        want = s.lights.sky >= 0 ? 0.5 : 0;              /* the sky's, where nothing else reaches */
+        worst_sum = fmax(worst_sum, any ? sum - 1 : fabs(sum - want));
+        if (any && !(sum > want)) worst_sum = 1;
+        if (k % 100 == 0 && any) {           /* choose_light's draws against light_choice */
+            static int hits[512];
+            double chi = 0, expect, z;
+            int draws = 40000, cells = 0, t, none = 0;
+            memset(hits, 0, sizeof hits);
+            for (t = 0; t < draws; t++) {
+                real chance;
+                int c = choose_light(&s, p, n, (real)rnd(&x), &chance);
+                if (c < 0) { none++; continue; }
+                hits[c]++;
+                worst_chance = fmax(worst_chance, fabs(chance / light_choice(&s, c, p, n) - 1));
+            }
+            for (l = 0; l < s.lights.nemit; l++) {
+                expect = draws * light_choice(&s, l, p, n);
+                if (expect >= 5) chi += (hits[l] - expect) * (hits[l] - expect) / expect, cells++;
+                else if (hits[l] > 0 && !(expect > 0)) chi = 1e9;     /* drawn at chance 0 */
+            }
+            expect = draws * (1 - sum);                       /* no light: the chance lost */
+            if (expect >= 5) chi += (none - expect) * (none - expect) / expect, cells++;
+            else if (none > 0 && !(expect > 0)) chi = 1e9;
+            /* Wilson and Hilferty (1931): chi-square of cells - 1 degrees of freedom as a normal z */
+            t = cells - 1;
+            z = t > 0 ? (pow(chi / t, 1.0 / 3) - (1 - 2.0 / (9 * t))) / sqrt(2.0 / (9 * t)) : 0;
+            worst_z = fmax(worst_z, z);
+            points++;
+        }
+    }
+    report(worst_sum < 1e-9, "the light tree: at any point the lights' chances add up to at most 1, to the sky's 1/2 where no other reaches",
+           "%s: worst difference %.2g over 3000 points", name, worst_sum);
+    report(worst_chance < 1e-9 && points >= 20 && worst_z < 4.5,
+           "the light tree: choose_light picks lights in light_choice's proportions, with its chance",
+           "%s: worst chance %.2g from light_choice's, worst chi-square %.2f standard normal deviates over %d points",
+           name, worst_chance, worst_z, points);
+    report(unreached == 0 && zeros > 100, "the light tree: a light given chance 0 cannot light the point",
+           "%s: %d of %d lights given chance 0 could (1600 points of each, at 4 times)", name, unreached, zeros);
+    free_scene(&s);
+}
+
+int main(int argc, char **argv)
+{
+    char file[4096];
+    sprintf(file, "%.4000s/lights.sph", argc > 1 ? argv[1] : "/tmp");
+    test_tree("scenes/lights100.sph", "lights100.sph", v3(-26, -26, 0), v3(26, 26, 4));
+    if (write_random_lights(file, 0, 3)) test_tree(file, "random lights", v3(-9, -9, 0), v3(9, 9, 9));
+    else report(0, "the light tree", "cannot write %s", file);
+    if (write_random_lights(file, 1, 4)) test_tree(file, "random lights under a sky", v3(-9, -9, 0), v3(9, 9, 9));
+    else report(0, "the light tree", "cannot write %s", file);
     test_pdf_agrees();
     int bad = 0, k;
     double chi = 0, ez = 0;
