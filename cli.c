@@ -472,7 +472,8 @@ static void print_stats_kv(FILE *f, const Stats *st)
             "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
             all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced,
             st->cut, st->discarded);
-    fprintf(f, "no_skip %d\nskipped_behind %llu\nskipped_faint %llu\n", st->no_skip, st->behind, st->faint);
+    fprintf(f, "no_skip %d\nskipped_behind %llu\nskipped_faint %llu\nskipped_dim %llu\n", st->no_skip, st->behind,
+            st->faint, st->dim);
     if (st->adaptive > 0)
         fprintf(f, "adaptive_steps %g\nsamples_taken %llu\nsamples_per_pixel %.4f\nsamples_min %d\nsamples_max %d\n",
                 st->adaptive, st->samples, (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max);
@@ -542,8 +543,9 @@ void print_stats(FILE *f, const Stats *st, int kv)
                 st->cut, st->budget);
     if (!st->path && st->no_skip) fprintf(f, "skips      none (--no-skip)\n");
     if (!st->path && !st->no_skip)
-        fprintf(f, "skips      %llu shadow rays to lights behind, %llu reflected or refracted rays of weight"
-                " under 1/512; blockers tried first (the shadow cache)\n", st->behind, st->faint);
+        fprintf(f, "skips      %llu shadow rays to lights behind, %llu to lights too dim to change the pixel"
+                " by a quarter step, %llu reflected or refracted rays of weight under 1/512; blockers tried"
+                " first (the shadow cache)\n", st->behind, st->dim, st->faint);
     if (st->adaptive > 0)
         fprintf(f, "adaptive   to %g steps: %.2f samples a pixel, from %d to %d (of %d)\n", st->adaptive,
                 (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max, st->spp);

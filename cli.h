@@ -82,7 +82,8 @@ typedef struct {
     int budget;                     /* Whitted: secondary rays a primary ray may spawn */
     double adaptive;                /* --adaptive's E, or 0 */
     int no_skip;                    /* --no-skip: every skip off */
-    unsigned long long behind, faint;   /* Whitted's skips: shadow rays to lights behind, faint rays */
+    unsigned long long behind, faint, dim;  /* Whitted's skips: shadow rays to lights behind, */
+                                        /* faint rays, shadow rays to lights too dim */
     unsigned long long samples;     /* the samples all pixels took */
     int spp_min, spp_max;           /* the fewest and the most a pixel took */
     double load, build, seconds, cpu;   /* seconds: reading, building, rendering; cpu: rendering */

@@ -367,8 +367,9 @@ typedef struct {
     unsigned long long tests, steps;            /* intersection tests, tree nodes visited */
     unsigned long long bounced, discarded;      /* path tracer: BSDF-sampled rays; bad samples */
     unsigned long long cut;                     /* Whitted: rays past a primary ray's budget */
-    unsigned long long behind, faint;           /* Whitted's skips: shadow rays to lights behind, */
-                                                /* rays of too little weight (see worth_tracing) */
+    unsigned long long behind, faint, dim;      /* Whitted's skips: shadow rays to lights behind, */
+                                                /* rays of too little weight (see worth_tracing), */
+                                                /* shadow rays to lights too dim (see too_dim) */
     unsigned long long samples;                 /* samples the pixels took, all together; */
     int spp_min, spp_max;                       /* the fewest and most one pixel took (0: none yet) */
     int threads;                                /* how many threads rendered */
@@ -393,6 +394,7 @@ typedef struct {
     unsigned long long pixel_key;   /* --sampler sobol: the pixel's own scramble, */
     int sample;                 /* and the sample's number in the pixel (-1: the pixel's) */
     int budget;                 /* Whitted: secondary rays the primary ray may still spawn */
+    real dim_budget;            /* Whitted: what too_dim may still leave out of this sample */
     const struct Hooks *hooks;  /* render()'s hooks, or NULL (see Hooks) */
     long long *splat;           /* this thread's splat image (see splat()), or NULL */
     int taken;                  /* samples the last pixel took (--view samples) */
@@ -517,12 +519,17 @@ static vec trace(const Scene *s, Ray r, int depth, real weight, Worker *wk);
 static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Worker *wk);
 static void lit_by(const Material *m, vec light, real e, vec dir, vec mirror, vec *color,
                    vec *spec);
-static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker *wk);
+static void area_lights(const Scene *s, const Hit *h, vec n, real weight, vec *color, Worker *wk);
 static void area_point(const Worker *wk, int l, int q, real *u, real *v);
 static vec glossy_mirror(vec mirror, real shine, const Worker *wk);
-static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real *e,
+static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real share, real *e,
                       vec *to_light, Worker *wk);
 static int worth_tracing(const Scene *s, real k, real weight, int depth, Worker *wk);
+static real dim_budget(const Scene *s);
+static int too_dim(const Scene *s, real share, Worker *wk);
+static real point_light_bound(const Material *m, const Light *l);
+static real brightest(vec c);
+static real area_light_bound(const Scene *s, const Material *m, int l, vec x);
 static vec reflect(vec d, vec n, real cosi);
 static int refract(vec d, vec n, real cosi, real eta, vec *t);
 
@@ -664,6 +671,7 @@ static const Tally *take_samples(const Scene *s, int i, int j, Tally *t, int n, 
         start_sample(wk, s, i, j, k);       /* for a lens, area lights, a glossy lobe */
         wk->count.primary++;
         wk->budget = RAY_BUDGET;
+        wk->dim_budget = dim_budget(s);
         r = primary_ray(s, i + dx, j + dy, wk);
         if (s->moving) r.time = shutter_time(s, k, shift);
         tally(t, trace(s, r, s->set.depth, 1, wk));
@@ -1348,9 +1356,10 @@ static vec shade(const Scene *s, Ray r, const Hit *h, int depth, real weight, Wo
     kr = tir && s->tir_reflect ? m->ks + m->kt : m->ks;
     for (i = 0; i < s->nlight; i++)
         if ((s->light[i].sphere < 0 || s->lights_centre)
-            && shadow_ray(s, h, n, &s->light[i], &e, &dir, wk))
+            && shadow_ray(s, h, n, &s->light[i], s->light[i].sphere >= 0 ? -1    /* the card's: never dim */
+                          : weight * point_light_bound(m, &s->light[i]), &e, &dir, wk))
             lit_by(m, s->light[i].color, e, dir, mirror, &color, &spec);
-    if (m->kd > 0) area_lights(s, h, n, &color, wk);     /* (only kd sees them) */
+    if (m->kd > 0) area_lights(s, h, n, weight, &color, wk);     /* (only kd sees them) */
     color = mul(color, m->color);
 
     c = scale(m->kl, m->color);                 /* emission */
@@ -1396,7 +1405,7 @@ static void lit_by(const Material *m, vec light, real e, vec dir, vec mirror, ve
  * path tracer's agree (a test holds them together).  No Phong highlight:
  * a highlight is the reflection of a light no ray can see, a point; the
  * mirror ray sees an area light as it sees any glowing object. */
-static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker *wk)
+static void area_lights(const Scene *s, const Hit *h, vec n, real weight, vec *color, Worker *wk)
 {
     vec wi, Le;
     real u, v, dist, pdf, e;
@@ -1405,6 +1414,7 @@ static void area_lights(const Scene *s, const Hit *h, vec n, vec *color, Worker 
         const Emitter *em = &s->lights.emit[l];
         if (em->type != TRIANGLE_LIGHT && (em->type != SPHERE_LIGHT || s->lights_centre)) continue;
         if (em->obj == h->obj) continue;        /* a sphere or a flat triangle lights not itself */
+        if (too_dim(s, weight * area_light_bound(s, &s->mat[h->mat], l, h->p), wk)) continue;
         for (q = 0; q < s->shadow_rays; q++) {
             area_point(wk, l, q, &u, &v);
             sample_emitter(s, l, h->p, n, h->time, u, v, &wi, &dist, &Le, &pdf);
@@ -1444,8 +1454,10 @@ static vec glossy_mirror(vec mirror, real shine, const Worker *wk)
 
 /* The lecture's shadow ray: is light l seen from the hit point?  *e returns
  * its strength kl * cos(angle to the normal n), *to_light the unit vector
- * toward it (shade() needs it again for the highlight). */
-static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
+ * toward it (shade() needs it again for the highlight).  share: the most
+ * the light can change the pixel through this hit (for too_dim; below 0:
+ * always sent). */
+static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l, real share,
                       real *e, vec *to_light, Worker *wk)
 {
     /* a glowing sphere that moves is where it is at the hit's instant */
@@ -1457,6 +1469,7 @@ static int shadow_ray(const Scene *s, const Hit *h, vec n, const Light *l,
     real k = l->sphere >= 0 ? s->mat[s->sph[l->sphere].mat].kl : 1;
     *e = k * dot(n, dir);
     if (!(*e > 0) && !s->set.no_skip) return wk->count.behind++, 0;  /* facing away: no ray (the SPD's rule) */
+    if (too_dim(s, share, wk)) return 0;                             /* it could not change the pixel */
     wk->count.shadow++;
     r = spawn(s, h, dir);
     if (l->sphere < 0)          /* a point light: anything before it blocks */
@@ -1489,6 +1502,57 @@ static int worth_tracing(const Scene *s, real k, real weight, int depth, Worker 
     if (wk->budget > 0) { wk->budget--; return 1; }
     wk->count.cut++;
     return 0;
+}
+
+/* Shadow rays not worth sending: a light whose share of the pixel is
+ * bound to be under what the sample can still leave out.  Each primary
+ * ray's tree may leave out a quarter of an 8-bit step of the pixel in all
+ * (dim_budget; through the sRGB curve, whose steepest slope is 12.92 at
+ * black, a quarter step of the bytes it writes), spent as it goes: a
+ * light whose bound, times the weight of the ray that found the hit, is
+ * still within what remains gets no shadow ray, and the remainder shrinks
+ * by it.  So whatever lights are left out, however many, together they
+ * change the pixel by under a quarter step, and its byte by at most one,
+ * only where it lay that close to a rounding boundary.  The card's
+ * glowing spheres (`lights centre`) always get theirs, so that the card's
+ * scene stays the card's image, byte for byte.  --no-skip sends every
+ * shadow ray. */
+static real dim_budget(const Scene *s)
+{
+    return (real)0.25 / 255 / (s->set.srgb ? (real)12.92 : 1);
+}
+
+static int too_dim(const Scene *s, real share, Worker *wk)
+{
+    if (s->set.no_skip || !(share >= 0 && share <= wk->dim_budget)) return 0;
+    wk->dim_budget -= share;
+    wk->count.dim++;
+    return 1;
+}
+
+/* The largest component of a colour. */
+static real brightest(vec c) { return fmax(c.x, fmax(c.y, c.z)); }
+
+/* The most a point light can add to a hit of material m: kd times its
+ * colour times the material's (the cosine at most 1), and a highlight's ks
+ * times its colour (cos^shine at most 1). */
+static real point_light_bound(const Material *m, const Light *l)
+{
+    return brightest(l->color) * (m->kd * brightest(m->color) + (m->shine > 0 ? m->ks : 0));
+}
+
+/* The most area light l can add to what a hit of material m at x
+ * reflects: kd times its colour times the light's radiance times the
+ * solid angle of the sphere about its light tree box (the cosines at most
+ * 1), over pi, as area_lights' sum estimates it. */
+static real area_light_bound(const Scene *s, const Material *m, int l, vec x)
+{
+    const LightNode *leaf = &s->lights.node[s->lights.leaf[l]];
+    int k, what = kind(s, s->lights.emit[l].obj, &k);
+    const Material *glow = &s->mat[what == SPHERE ? s->sph[k].mat : s->tri[k].mat];
+    vec d = sub(x, leaf->centre);
+    real d2 = dot(d, d), omega = d2 > leaf->r2 ? 2 * (real)PI * (1 - sqrt(1 - leaf->r2 / d2)) : 2 * (real)PI;
+    return m->kd * brightest(m->color) * glow->kl * brightest(glow->color) * omega / (real)PI;
 }
 
 /* The mirror direction of d about the normal n, where cosi = -d.n > 0. */
@@ -3384,6 +3448,7 @@ static void add_counts(Counts *to, const Counts *from)
     to->discarded += from->discarded;
     to->cut += from->cut;
     to->behind += from->behind;
+    to->dim += from->dim;
     to->faint += from->faint;
     to->samples += from->samples;
     if (from->spp_max && (!to->spp_max || from->spp_min < to->spp_min)) to->spp_min = from->spp_min;
@@ -3984,7 +4049,7 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.refracted = c->refracted, st.bounced = c->bounced, st.cut = c->cut, st.budget = RAY_BUDGET;
     st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
     st.hits = c->hits, st.tests = c->tests, st.steps = c->steps;
-    st.no_skip = s->set.no_skip, st.behind = c->behind, st.faint = c->faint;
+    st.no_skip = s->set.no_skip, st.behind = c->behind, st.faint = c->faint, st.dim = c->dim;
     st.adaptive = s->set.adaptive, st.samples = c->samples, st.spp_min = c->spp_min, st.spp_max = c->spp_max;
     st.load = load, st.build = build, st.seconds = seconds, st.cpu = cpu;
     print_stats(stderr, &st, kv);

@@ -16,7 +16,7 @@
  * And the light tree that chooses among many lights (prepare_lights,
  * choose_light, light_choice), on scenes/lights100.sph and on a scene of
  * random point lights, glowing spheres and one- and two-sided triangles,
- * some moving, with and without a sky:
+ * some moving, with and without a sky, and of such triangles alone:
  *  - every node bounds its children: box, cone of normals, spread, power;
  *  - at any point the chances of all the lights add up to 1 (or to the
  *    sky's, where no other light can reach), choose_light's chance is
@@ -198,20 +198,20 @@ static void test_pdf_agrees(void)
 }
 
 /* A scene of random lights of every kind the tree holds, into file. */
-static int write_random_lights(const char *file, int sky, unsigned long long x)
+static int write_random_lights(const char *file, int sky, int triangles_only, unsigned long long x)
 {
     FILE *f = fopen(file, "w");
     int i;
     if (!f) return 0;
     fprintf(f, "integrator path\nbackground %s\nshutter 0 1\n", sky ? ".2 .3 .4" : "0 0 0");
     fprintf(f, "tri -20 -20 0  20 -20 0  20 20 0  .8 .8 .8 .8 0 0 0 1\n");
-    for (i = 0; i < 10; i++)
+    for (i = 0; i < 10 * !triangles_only; i++)
         fprintf(f, "light %.3f %.3f %.3f  %.3f .5 .5\n", 16 * rnd(&x) - 8, 16 * rnd(&x) - 8, 8 * rnd(&x), 2 * rnd(&x));
     for (i = 0; i < 60; i++) {
         double c[3] = { 16 * rnd(&x) - 8, 16 * rnd(&x) - 8, 1 + 7 * rnd(&x) }, r = 0.05 + 0.8 * rnd(&x);
         if (i == 20) fprintf(f, "sided 1\n");
         fprintf(f, "move %.3f %.3f %.3f\n", i % 3 ? 0 : 4 * rnd(&x) - 2, i % 3 ? 0 : 4 * rnd(&x) - 2, 0.0);
-        if (i % 4 == 0)
+        if (i % 4 == 0 && !triangles_only)
             fprintf(f, "%.3f %.3f %.3f  1 1 1  %.3f  0 0 0 %.3f 1\n", c[0], c[1], c[2], r, 0.1 + 5 * rnd(&x));
         else
             fprintf(f, "tri %.3f %.3f %.3f  %.3f %.3f %.3f  %.3f %.3f %.3f  1 1 1 0 0 0 %.3f 1\n",
@@ -356,9 +356,11 @@ int main(int argc, char **argv)
     char file[4096];
     sprintf(file, "%.4000s/lights.sph", argc > 1 ? argv[1] : "/tmp");
     test_tree("scenes/lights100.sph", "lights100.sph", v3(-26, -26, 0), v3(26, 26, 4));
-    if (write_random_lights(file, 0, 3)) test_tree(file, "random lights", v3(-9, -9, 0), v3(9, 9, 9));
+    if (write_random_lights(file, 0, 0, 3)) test_tree(file, "random lights", v3(-9, -9, 0), v3(9, 9, 9));
     else report(0, "the light tree", "cannot write %s", file);
-    if (write_random_lights(file, 1, 4)) test_tree(file, "random lights under a sky", v3(-9, -9, 0), v3(9, 9, 9));
+    if (write_random_lights(file, 1, 0, 4)) test_tree(file, "random lights under a sky", v3(-9, -9, 0), v3(9, 9, 9));
+    else report(0, "the light tree", "cannot write %s", file);
+    if (write_random_lights(file, 0, 1, 5)) test_tree(file, "random triangles", v3(-9, -9, 0), v3(9, 9, 9));
     else report(0, "the light tree", "cannot write %s", file);
     test_pdf_agrees();
     int bad = 0, k;

@@ -994,7 +994,7 @@ static int acne_at_scale(double k, int *counted)
             double b, dist2, len;
             int lit, truth;
             if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &wk)) continue;
-            lit = shadow_ray(&s, &h, h.n, l, &e, &ld, &wk);
+            lit = shadow_ray(&s, &h, h.n, l, -1, &e, &ld, &wk);
             if (!(e > 1e-6)) continue;     /* grazing or facing away */
             /* exact: does the segment from the point to the light pass
              * through the ball (if the point is on the ground), in units of k */
@@ -1044,7 +1044,7 @@ static int lone_acne(int cylinder, double k, double far, int *counted)
             vec ld;
             int lit;
             if (!nearest_hit(&s, camera_ray(&s.cam, W, W, i + 0.5, j + 0.5), &h, &wk)) continue;
-            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], &e, &ld, &wk);
+            lit = shadow_ray(&s, &h, dot(h.n, v3(0, -1, 0)) > 0 ? h.n : scale(-1, h.n), &s.light[0], -1, &e, &ld, &wk);
             if (!(e > 1e-6)) continue;
             ++*counted;
             wrong += !lit || self_hit(&s, &h, unit(sub(s.light[0].pos, h.p)));
@@ -1078,6 +1078,68 @@ static void test_acne(void)
         sprintf(name, "no acne: plane and ball at scale %g", k);
         report(wrong == 0 && counted > 3000, name, "%g wrongly shadowed of %g lit-side pixels", wrong, counted);
     }
+}
+
+/* The dim lights' cull (too_dim): at every pixel of four scenes (point
+ * lights, a glowing sphere, 100 of them, a lamp of triangles), the
+ * primary ray traced with the cull and without differs by no more than
+ * a sample may leave out (a quarter of an 8-bit step), and only ever
+ * darker; and the cull fires, so the check is not empty. */
+static void test_dim_lights(const char *file)
+{
+    Scene s;
+    Worker wk;
+    double worst = 0, brighter = 0;
+    unsigned long long culled = 0;
+    int i, j, w = 64, h = 48, ok;
+    if (!load_or_fail(&s, file, "the dim lights' cull")) return;
+    s.set.w = w, s.set.h = h;
+    if (!settle_path_options(&s, WHITTED, -1, 1, 0) || !build_accel(&s, "bvh")) {
+        printf("FAIL the dim lights' cull (%s: cannot prepare)\n", file);
+        failures++;
+        return;
+    }
+    memset(&wk, 0, sizeof wk);
+    for (j = 0; j < h; j++)
+        for (i = 0; i < w; i++) {
+            Ray r = primary_ray(&s, i + (real)0.5, j + (real)0.5, &wk);
+            vec with, without;
+            unsigned long long before = wk.count.dim;
+            wk.budget = RAY_BUDGET, wk.dim_budget = dim_budget(&s);
+            with = trace(&s, r, s.set.depth, 1, &wk);
+            culled += wk.count.dim - before;
+            wk.budget = RAY_BUDGET, wk.dim_budget = -1;          /* nothing is within -1 */
+            without = trace(&s, r, s.set.depth, 1, &wk);
+            worst = fmax(worst, fmax(without.x - with.x, fmax(without.y - with.y, without.z - with.z)));
+            brighter = fmax(brighter, fmax(with.x - without.x, fmax(with.y - without.y, with.z - without.z)));
+        }
+    ok = culled > 0 && worst <= 0.25 / 255 * (1 + 1e-9) && brighter <= 1e-12;
+    printf("%s the dim lights' cull leaves out at most a quarter step of a pixel, and only darkens (%s: %llu shadow"
+           " rays not sent, worst %.3g of a step darker, %.2g brighter)\n", ok ? "PASS" : "FAIL",
+           strrchr(file, '/') ? strrchr(file, '/') + 1 : file, culled,
+           worst * 255, brighter * 255);
+    failures += !ok;
+    free_scene(&s);
+}
+
+/* The same for lamps of triangles: a mirror ball and a floor under a
+ * row of small, dim, two-sided triangles, far and near. */
+static void test_dim_triangles(void)
+{
+    char name[4200];
+    FILE *f;
+    int k;
+    sprintf(name, "%.4000s/dim_triangles.sph", getenv("TMP") ? getenv("TMP") : ".");
+    if (!(f = fopen(name, "w"))) { printf("FAIL the dim lights' cull (cannot write %s)\n", name); failures++; return; }
+    fprintf(f, "size 64 48\ndepth 4\ncamera 0 -8 3  0 0 1  0 0 1  50\nlight 3 -4 6  .5 .5 .5\n"
+               "tri -9 -9 0  9 -9 0  9 9 0  .8 .8 .8 .7 .3 0 0 1\ntri -9 -9 0  9 9 0  -9 9 0  .8 .8 .8 .7 .3 0 0 1\n"
+               "0 0 1  1 1 1  1  0 .9 0 0 1\n");
+    for (k = 0; k < 30; k++)
+        fprintf(f, "tri %d 8 %d  %d.2 8 %d  %d 8 %d.2  1 1 1 0 0 0 %g 1\n", k - 15, 1 + k % 5, k - 15, 1 + k % 5,
+                k - 15, 1 + k % 5, 0.02 + 0.02 * (k % 7));
+    fclose(f);
+    test_dim_lights(name);
+    remove(name);
 }
 
 int main(void)
@@ -1122,6 +1184,10 @@ int main(void)
     test_tree_image("grid");
     test_tir();
     test_budget();
+    test_dim_lights("scenes/whitted.sph");
+    test_dim_lights("scenes/demo.nff");
+    test_dim_lights("scenes/lights100.sph");
+    test_dim_triangles();
     test_float_range();
     test_light_under_ceiling();
     test_acne();

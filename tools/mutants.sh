@@ -28,6 +28,7 @@
 #            (50000 rays, as make test), and tests/counts.test.sh (the
 #            structures' work on fixed scenes)
 #     grid   the same for the grid
+#     whitted  tests/test_ray.c (Whitted's renderer: hits, shading, the skips)
 #     light  tests/light.test.sh (tests/test_light.c: Arvo's sampler and the
 #            light tree; the light choice's images)
 #
@@ -49,6 +50,7 @@ ref=$(mktemp -d "${TMPDIR:-/tmp}/mutants.XXXXXX") || exit 2
 trap 'rm -rf "$ref"' EXIT
 
 build_pt='cc -O2 -std=c99 -o t tests/test_pt.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || exit 3'
+build_whitted='cc -O2 -std=c99 -o t tests/test_ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || exit 3'
 build_light='cc -O2 -std=c99 -o t tests/test_light.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || exit 3'
 build_accel='cc -O2 -o t tests/test_accel.c kdtree.c bvh.c grid.c -lm || exit 3; make -s ray tools/spd >/dev/null 2>&1 || exit 3'
 scenes='same mesh grid thirds tenths soup flat empty one'
@@ -57,6 +59,7 @@ scenes='same mesh grid thirds tenths soup flat empty one'
 tests_of() {
   case $1 in
     pt) echo "$build_pt; ./t >out 2>&1 || echo \"FAIL tests/test_pt.c exited \$?\" >>out; ! grep '^FAIL' out" ;;
+    whitted) echo "$build_whitted; TMP=. ./t >out 2>&1 || echo \"FAIL tests/test_ray.c exited \$?\" >>out; ! grep '^FAIL' out" ;;
     light) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/light.test.sh >out 2>&1 || echo 'FAIL tests/light.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     bvh|grid)
       local structs=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
@@ -73,6 +76,10 @@ probe_of() {
     pt) echo "$build_pt; make -s ray >/dev/null 2>&1 || exit 3; ./t;
               for f in cornell veach caustic smallpt bleed whitted minray mesh; do for e in bsdf nee mis; do
                 ./ray --pt -t 1 -s 24x16 -n 4 --estimator \$e -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f \$e; cksum <p.pfm;
+              done; done" ;;
+    whitted) echo "$build_whitted; make -s ray >/dev/null 2>&1 || exit 3; TMP=. ./t 2>&1;
+              for f in whitted mesh minray lights100 soft demo; do for g in '' --gamma; do
+                ls scenes/\$f.* | head -1 | xargs ./ray --whitted -t 1 -s 32x24 -n 2 \$g -o p.pfm 2>/dev/null; echo \$f \$g; cksum <p.pfm;
               done; done" ;;
     light) echo "$build_light; make -s ray >/dev/null 2>&1 || exit 3; ./t . | sed 's/[0-9][0-9.]* s\\b//';
               for f in lights100 cornell veach lamp soft; do for c in importance power; do
