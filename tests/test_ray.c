@@ -1080,6 +1080,46 @@ static void test_acne(void)
     }
 }
 
+/* area_light_bound against what area_lights estimates, at points near
+ * each lamp and far from it: the mean of 4000 of its samples (on a white
+ * kd 1 surface, nothing in the way) may not exceed the bound by more than
+ * 4 standard errors. */
+static int area_bounds_hold(const Scene *s, const char *file)
+{
+    Material white;
+    unsigned long long x = 9;
+    double worst = -1e9;
+    int l, k, q, tried = 0;
+    memset(&white, 0, sizeof white);
+    white.color = v3(1, 1, 1), white.kd = 1;
+    for (l = 0; l < s->lights.nemit; l++) {
+        const LightNode *leaf = &s->lights.node[s->lights.leaf[l]];
+        if (s->lights.emit[l].type != SPHERE_LIGHT && s->lights.emit[l].type != TRIANGLE_LIGHT) continue;
+        for (k = 0; k < 8; k++) {
+            double r = sqrt(leaf->r2) * (k < 4 ? 1.05 + k * 0.5 : 4 << k), sum = 0, sq = 0, mean, se;
+            vec d = unit(v3(rnd(&x) - .5, rnd(&x) - .5, rnd(&x) - .5)), p = comb(r, d, leaf->centre);
+            vec n = unit(comb(-1, d, v3(0.3 * (rnd(&x) - .5), 0.3 * (rnd(&x) - .5), 0.3 * (rnd(&x) - .5))));
+            for (q = 0; q < 4000; q++) {
+                vec wi, Le;
+                real dist, pdf, e;
+                double v = 0;
+                sample_emitter(s, l, p, n, 0, (real)rnd(&x), (real)rnd(&x), &wi, &dist, &Le, &pdf);
+                e = dot(n, wi);
+                if (pdf > 0 && e > 0) v = e * fmax(Le.x, fmax(Le.y, Le.z)) / (PI * pdf);
+                sum += v, sq += v * v;
+            }
+            mean = sum / 4000, se = sqrt(fmax(0, sq / 4000 - mean * mean) / 4000);
+            worst = fmax(worst, (mean - area_light_bound(s, &white, l, p)) / (se > 0 ? se : 1e-300));
+            tried++;
+        }
+    }
+    if (tried == 0) return 1;                           /* point lights only */
+    printf("%s area_light_bound holds: area_lights' estimate from near and far never above it (%s: worst %.2f"
+           " standard errors above, of %d points)\n", worst < 4 ? "PASS" : "FAIL",
+           strrchr(file, '/') ? strrchr(file, '/') + 1 : file, worst, tried);
+    return worst < 4;
+}
+
 /* The dim lights' cull (too_dim): at every pixel of four scenes (point
  * lights, a glowing sphere, 100 of them, a lamp of triangles), the
  * primary ray traced with the cull and without differs by no more than
@@ -1114,6 +1154,7 @@ static void test_dim_lights(const char *file)
             brighter = fmax(brighter, fmax(with.x - without.x, fmax(with.y - without.y, with.z - without.z)));
         }
     ok = culled > 0 && worst <= 0.25 / 255 * (1 + 1e-9) && brighter <= 1e-12;
+    if (s.lights.nemit > 0) ok &= area_bounds_hold(&s, file);
     printf("%s the dim lights' cull leaves out at most a quarter step of a pixel, and only darkens (%s: %llu shadow"
            " rays not sent, worst %.3g of a step darker, %.2g brighter)\n", ok ? "PASS" : "FAIL",
            strrchr(file, '/') ? strrchr(file, '/') + 1 : file, culled,
