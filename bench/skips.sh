@@ -102,7 +102,7 @@ while IFS='|' read -r label scene size with without ladder; do
       times[$n]+="$cpu "
     done
   done
-  row "$OUT/skips.tsv" "$k" with 0 "$OUT/skips-$k-with.pfm" "${times[with]}"
+  row "$OUT/skips.tsv" "$k" with "$(sed -n 's/.*-n \([0-9]*\).*/\1/p' <<<"$with")" "$OUT/skips-$k-with.pfm" "${times[with]}"
   t_with=$med e_with=$lit
   for n in $ladder; do row "$OUT/skips.tsv" "$k" without "$n" "$OUT/skips-$k-$n.pfm" "${times[$n]}"; done
   t_wo=$(table time-at "$OUT/skips.tsv" "$k" without "$e_with" 0)
