@@ -8,3 +8,6 @@ cd "$(dirname "$0")/.."
 for s in cornell smallpt caustic bleed; do
   ./ray --stats -o "docs/pt/$s.png" "scenes/$s.sph" 2>&1 | grep -E '^(image|time)' | sed "s/^/$s: /"
 done
+# the light tree against choosing by power, at the same 16 samples (the README's "Many lights")
+./ray -n 16 --light-choice power -o docs/pt/lights100-power.png scenes/lights100.sph
+./ray -n 16 -o docs/pt/lights100-tree.png scenes/lights100.sph
