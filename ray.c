@@ -87,7 +87,7 @@
  *       write_image()     the image to its file                     (image.c)
  *
  * One path-traced sample, in the Cornell box (a triangle lit by a
- * triangle; 14 marked ^ of 48):
+ * triangle; 14 marked ^ of 50):
  *
  *       main(), ^ render(), ^ render_row()                          as above
  *       pixel_radiance()  the mean of the pixel's samples           Kajiya
@@ -1999,6 +1999,42 @@ static void bound_lights(LightNode *k, const LightNode *a, const LightNode *b)
     k->cos_o = cos(t), k->sin_o = sin(t);
 }
 
+/* A light for the point x of normal n, chosen by the number u, and the
+ * chance of choosing it; -1 when none can light x.  The sky half the
+ * time when there are other lights; else down the tree, at each node one
+ * half by its weight against the other's, the rest of u choosing on.  A
+ * node whose bound let it be chosen may find both halves weigh 0: that
+ * draw finds no light, so the chances add up to less than 1, but no light
+ * that could reach x is ever left out, and the estimate stays unbiased. */
+static int choose_light(const Scene *s, vec x, vec n, real u, real *chance)
+{
+    const Lights *L = &s->lights;
+    int k = L->root;
+    *chance = 1;
+    if (L->sky >= 0 && (k < 0 || u < (real)0.5)) {
+        *chance = k < 0 ? 1 : (real)0.5;
+        return L->sky;
+    }
+    if (k < 0) return -1;
+    if (L->sky >= 0) u = 2 * u - 1, *chance = (real)0.5;
+    while (L->node[k].light < 0) {
+        const int *c = L->node[k].child;
+        real a = node_weight(s, c[0], x, n), b = node_weight(s, c[1], x, n), p = a / (a + b);
+        if (!(a + b > 0)) return -1;
+        if (u < p || !(b > 0)) u = fmin(u / p, 1), *chance *= a / (a + b), k = c[0];
+        else u = fmin((u - p) / (1 - p), 1), *chance *= b / (a + b), k = c[1];
+    }
+    return L->node[k].light;
+}
+
+/* How much sample_light favours the lights below node k at x: what they
+ * may bring there, or (--light-choice power) their power alone. */
+static real node_weight(const Scene *s, int k, vec x, vec n)
+{
+    const LightNode *node = &s->lights.node[k];
+    return s->set.light_choice == BY_POWER ? node->power : importance(node, x, n);
+}
+
 /* What the lights below node k may bring to the point x of normal n:
  * their power over the squared distance, times the cosine at each end as
  * large as any light within the box could make it (Conty Estevez and
@@ -2029,42 +2065,6 @@ static real importance(const LightNode *k, vec x, vec n)
     if (cos_i < cos_b) cos_s = cos_i * cos_b + sqrt(fmax(0, (1 - cos_i * cos_i) * sin2_b));
     if (cos_s <= 0) return 0;                           /* every light lies below x's horizon */
     return k->power * cos_l * cos_s / near;
-}
-
-/* How much sample_light favours the lights below node k at x: what they
- * may bring there, or (--light-choice power) their power alone. */
-static real node_weight(const Scene *s, int k, vec x, vec n)
-{
-    const LightNode *node = &s->lights.node[k];
-    return s->set.light_choice == BY_POWER ? node->power : importance(node, x, n);
-}
-
-/* A light for the point x of normal n, chosen by the number u, and the
- * chance of choosing it; -1 when none can light x.  The sky half the
- * time when there are other lights; else down the tree, at each node one
- * half by its weight against the other's, the rest of u choosing on.  A
- * node whose bound let it be chosen may find both halves weigh 0: that
- * draw finds no light, so the chances add up to less than 1, but no light
- * that could reach x is ever left out, and the estimate stays unbiased. */
-static int choose_light(const Scene *s, vec x, vec n, real u, real *chance)
-{
-    const Lights *L = &s->lights;
-    int k = L->root;
-    *chance = 1;
-    if (L->sky >= 0 && (k < 0 || u < (real)0.5)) {
-        *chance = k < 0 ? 1 : (real)0.5;
-        return L->sky;
-    }
-    if (k < 0) return -1;
-    if (L->sky >= 0) u = 2 * u - 1, *chance = (real)0.5;
-    while (L->node[k].light < 0) {
-        const int *c = L->node[k].child;
-        real a = node_weight(s, c[0], x, n), b = node_weight(s, c[1], x, n), p = a / (a + b);
-        if (!(a + b > 0)) return -1;
-        if (u < p || !(b > 0)) u = fmin(u / p, 1), *chance *= a / (a + b), k = c[0];
-        else u = fmin((u - p) / (1 - p), 1), *chance *= b / (a + b), k = c[1];
-    }
-    return L->node[k].light;
 }
 
 /* The chance that choose_light picks light l at x, of normal n: the
