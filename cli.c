@@ -40,7 +40,9 @@ void usage(FILE *to)
           "  --pt       path tracing (Kajiya's rendering equation); --whitted: Whitted's\n"
           "             (default: the scene's `integrator`, else Whitted)\n"
           "  --estimator E  the path tracer's: bsdf (BSDF sampling only), nee (next-event\n"
-          "             estimation) or mis (both, by multiple importance sampling; default)\n"
+          "             estimation), mis (both, by multiple importance sampling; default)\n"
+          "             or light (light tracing: paths from the lights, joined to the\n"
+          "             camera; whole images only, no --adaptive)\n"
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
           "  --sampler S  the path tracer's numbers: independent (a hash of the sample\n"
           "             and the dimension; default) or sobol (Owen-scrambled Sobol'\n"
@@ -243,9 +245,10 @@ static int estimator_arg(const char *v)
 {
     if (!strcmp(v, "bsdf")) return 0;
     if (!strcmp(v, "nee")) return 1;
+    if (!strcmp(v, "light")) return 3;
     if (strcmp(v, "mis")) {
         fprintf(stderr, "ray: --estimator takes bsdf (BSDF sampling only), nee (next-event"
-                " estimation) or mis, not %s\n", v);
+                " estimation), mis or light (light tracing), not %s\n", v);
         exit(2);
     }
     return 2;
@@ -443,7 +446,7 @@ static unsigned long long all_rays(const Stats *st)
 /* --stats=kv: for programs to read (bench/run.sh does). */
 static void print_stats_kv(FILE *f, const Stats *st)
 {
-    static const char *const estimators[] = { "bsdf", "nee", "mis" };
+    static const char *const estimators[] = { "bsdf", "nee", "mis", "light" };
     fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
             st->spheres, st->cones, st->triangles, st->point_lights, st->glowing);
     fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", st->w, st->h, st->spp,
@@ -510,7 +513,8 @@ static void print_accel(FILE *f, const Stats *st)
 void print_stats(FILE *f, const Stats *st, int kv)
 {
     static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
-                                              "MIS (BSDF sampling and next-event estimation)" };
+                                              "MIS (BSDF sampling and next-event estimation)",
+                                              "light tracing (paths from the lights, to the camera)" };
     unsigned long long rays = all_rays(st);
     if (kv) {
         print_stats_kv(f, st);

@@ -237,7 +237,7 @@ typedef struct {
     int depth;                /* Whitted: the recursion's depth */
     int max_rays;             /* path tracing: rays on a path at most (-d); 0: no bound but roulette */
     int spp;                  /* samples per pixel the scene asks for (0: none said) */
-    int estimator;            /* the path tracer's: BSDF_ONLY, NEE or MIS */
+    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS or LIGHT_TRACING */
     int roulette;             /* 1: Russian roulette ends paths */
     unsigned seed;            /* --seed: which noise */
     int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, or 0 */
@@ -325,7 +325,7 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
  * only, by next-event estimation, or by both weighed by MIS. */
 enum { WHITTED, PATH };
 enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
-enum { BSDF_ONLY, NEE, MIS };
+enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING };
 enum { INDEPENDENT, SOBOL };
 enum { BY_IMPORTANCE, BY_POWER };
 
@@ -540,6 +540,12 @@ static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk);
 static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk);
 static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk);
 static int survives(const Scene *s, int rays, vec *beta, vec *f_cos_pdf, Worker *wk);
+static vec seen_directly(const Scene *s, Ray r, Worker *wk);
+static void splat(const Scene *s, Worker *wk, real x, real y, vec L);
+static void trace_light_path(const Scene *s, int i, int j, int k, real time, Worker *wk);
+static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta);
+static void to_camera(const Scene *s, const Hit *h, const Bsdf *b, vec wl, vec beta, Worker *wk);
+static int camera_sees(const Scene *s, vec wc, real dist, real time, Worker *wk);
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
@@ -551,7 +557,8 @@ static void bound_lights(LightNode *k, const LightNode *a, const LightNode *b);
 static void sphere_of_box(LightNode *k);
 static real coordinate(vec v, int a);
 static real importance(const LightNode *k, vec x, vec n);
-static real node_weight(const Scene *s, int k, vec x, vec n);
+static real node_weight(const Scene *s, int k, vec x, vec n, int by_power);
+static int down_the_tree(const Scene *s, vec x, vec n, int by_power, real u, real *chance);
 static int choose_light(const Scene *s, vec x, vec n, real u, real *chance);
 static real light_choice(const Scene *s, int l, vec x, vec n);
 static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u, real v,
@@ -1693,6 +1700,11 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     path.counted = 1;
     r = primary_ray(s, i + dx, j + dy, wk);
     if (s->moving) r.time = shutter_time(s, k, st);
+    if (s->set.estimator == LIGHT_TRACING) {     /* the camera's half, then one light path */
+        vec L = seen_directly(s, r, wk);
+        trace_light_path(s, i, j, k, r.time, wk);
+        return L;
+    }
     return radiance(s, r, &path, wk);
 }
 
@@ -1726,6 +1738,178 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
     next.n_from = b.n;
     Li = radiance(s, spawn(s, &h, wi), &next, wk);
     return add(add(emission, direct), mul(f_cos_pdf, Li));
+}
+
+/* ------------------------------------------------------------ light tracing */
+
+/* Light tracing (--estimator light): the paths run the other way, from the
+ * lights, as the light itself goes (Arvo, "Backward ray tracing", 1986;
+ * Veach's thesis, 1997, section 10.2: the strategy t = 1 of bidirectional
+ * path tracing).  At every vertex a light path meets, it is joined to the
+ * camera by a straight line, and what that vertex sends along it is
+ * splatted into the pixel the line crosses (to_camera).  A light path is
+ * traced for every camera sample, from that sample's numbers, so the
+ * bytes are the same on any number of threads.  The camera's own half
+ * (seen_directly) counts only the lights it sees, directly or through
+ * mirrors and glass, since no straight line from a light path reaches the
+ * camera through them; what the camera sees of a diffuse surface through
+ * glass (the floor through the ball) no path of either half finds, and is
+ * black.  The sky lights nothing (no light path starts from it); BSDFs are
+ * taken as symmetric, which they are but for shading normals and the
+ * radiance a refraction compresses (which cancels through a closed glass
+ * object). */
+#define LIGHT_PATH MAX_PATH             /* its numbers: the blocks after the camera path's */
+
+/* The camera's half: the lights seen from the camera directly, or through
+ * a chain of mirrors and glass; the first other lobe ends it. */
+static vec seen_directly(const Scene *s, Ray r, Worker *wk)
+{
+    Path path;
+    vec beta = v3(1, 1, 1), L = v3(0, 0, 0);
+    int rays, most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
+    memset(&path, 0, sizeof path);
+    path.counted = 1;                           /* whatever it meets counts in full */
+    for (rays = 1; ; rays++) {
+        Hit h;
+        Bsdf b;
+        vec wi, f_cos_pdf, wo = scale(-1, r.d);
+        real pdf;
+        int lobe;
+        if (!nearest_hit(s, r, &h, wk)) return add(L, mul(beta, sky(s, r.d, &path)));
+        L = add(L, mul(beta, emitted(s, &h, wo, &path)));
+        if (rays == most) return L;
+        bsdf_at(s, &h, wo, &b);
+        wk->bounce = rays - 1;
+        lobe = sample_bsdf(&b, wo, wk, &wi, &f_cos_pdf, &pdf);
+        if (lobe != MIRROR_LOBE && lobe != GLASS_LOBE) return L;
+        beta = mul(beta, f_cos_pdf);
+        r = spawn(s, &h, wi);
+    }
+}
+
+/* One light path, from a light chosen by its power at the given time,
+ * joined to the camera at every vertex.  beta is what the path carries:
+ * Le cos over the pdf of its start, times f cos / pdf at every bounce, as
+ * a camera path's throughput is (Veach 1997, eq. 10.6).  Its rays: the
+ * light's first, each bounce's, and the line to the camera, at most -d. */
+static void trace_light_path(const Scene *s, int i, int j, int k, real time, Worker *wk)
+{
+    Ray r;
+    vec beta;
+    real chance;
+    int l, rays, most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
+    start_sample(wk, s, i, j, k);
+    wk->bounce = LIGHT_PATH;
+    l = down_the_tree(s, v3(0, 0, 0), v3(0, 0, 0), 1, bounce_random(wk, LIGHT_CHOICE), &chance);
+    if (l < 0 || !emit_ray(s, l, time, wk, &r, &beta)) return;
+    beta = scale(1 / chance, beta);
+    for (rays = 2; rays <= most; rays++) {     /* the line to the camera is ray number `rays` */
+        Hit h;
+        Bsdf b;
+        vec wi, f_cos_pdf, wl = scale(-1, r.d);
+        real pdf;
+        if (!nearest_hit(s, r, &h, wk)) return;
+        wk->count.bounced++;
+        wk->bounce = LIGHT_PATH + rays - 1;
+        bsdf_at(s, &h, wl, &b);
+        to_camera(s, &h, &b, wl, beta, wk);
+        if (rays == most || sample_bsdf(&b, wl, wk, &wi, &f_cos_pdf, &pdf) < 0) return;
+        beta = mul(beta, f_cos_pdf);
+        if (!survives(s, rays, &beta, &f_cos_pdf, wk)) return;
+        r = spawn(s, &h, wi);
+    }
+}
+
+/* A ray leaving light l at the given time, its point and direction drawn
+ * from this bounce's numbers, and what it carries, Le cos / pdf: from a
+ * point light of intensity I, sent the same way in every direction
+ * (pdf 1 / 4 pi), 4 pi I; from a point of an emitting sphere or triangle
+ * of area A (each side of a two-sided one counted), sent by the cosine
+ * (pdf cos / pi), pi A Le.  0 when nothing can leave. */
+static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta)
+{
+    const Emitter *e = &s->lights.emit[l];
+    const Material *m;
+    real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V), area;
+    vec n, local = cosine_hemisphere(bounce_random(wk, DIRECTION_U), bounce_random(wk, DIRECTION_V));
+    int k, what;
+    r->tmin = 0, r->time = time, r->skip = -1;
+    if (e->type == POINT_LIGHT) {
+        real z = 1 - 2 * u, rho = sqrt(fmax(0, 1 - z * z));
+        r->o = e->pos;
+        r->d = v3(rho * cos(2 * PI * v), rho * sin(2 * PI * v), z);
+        *beta = scale(4 * (real)PI, e->intensity);
+        return 1;
+    }
+    if (e->type != SPHERE_LIGHT && e->type != TRIANGLE_LIGHT) return 0;
+    what = kind(s, e->obj, &k);
+    if (what == SPHERE) {
+        real z = 1 - 2 * u, rho = sqrt(fmax(0, 1 - z * z));
+        n = v3(rho * cos(2 * PI * v), rho * sin(2 * PI * v), z);
+        r->o = comb(s->sph[k].rad, n, s->sph[k].cen);
+        area = 4 * (real)PI * s->sph[k].rad * s->sph[k].rad;
+        m = &s->mat[s->sph[k].mat];
+    } else {
+        vec c = cross(s->tri[k].e1, s->tri[k].e2);
+        triangle_sample(&s->tri[k], u, v, &r->o, &n);
+        area = sqrt(dot(c, c)) / 2;
+        if (!s->tri[k].cull) {                  /* either side, half the time each */
+            if (bounce_random(wk, LOBE) < (real)0.5) n = scale(-1, n);
+            area *= 2;
+        }
+        m = &s->mat[s->tri[k].mat];
+    }
+    if (moves(s, e->obj)) r->o = comb(time, velocity(s, e->obj), r->o);
+    r->d = from_local(n, local);
+    r->skip = e->obj;                           /* it leaves the surface outward */
+    *beta = scale((real)PI * area * m->kl, m->color);
+    return 1;
+}
+
+/* Whether the camera sees the point that lies dist from it the other way
+ * along wc: tested from the eye, as the camera's own ray would be (a
+ * one-sided triangle lets a ray through from behind, not back), up to a
+ * hair short of the point so that its own surface does not hide it. */
+static int camera_sees(const Scene *s, vec wc, real dist, real time, Worker *wk)
+{
+    Ray r;
+    r.o = s->cam.eye;
+    r.d = scale(-1, wc);
+    r.tmin = near_clip(&s->cam, r.d);
+    r.skip = -1;
+    r.time = time;
+    return !any_hit(s, r, dist * (1 - 1024 * REAL_EPS), &wk->blocker[0], wk);
+}
+
+/* What vertex h of a light path, reached from direction wl with
+ * throughput beta, sends to the camera, into the pixel the line to the
+ * eye crosses.  The pinhole's image plane stands D = w / (2 tan(fov / 2))
+ * pixels from the eye, so a pixel's radiance is the integral of L over
+ * its solid angle times D^2 / cos^3 (the plane's area against the solid
+ * angle it fills), and the solid angle of the surface around h is
+ * cos_y dA / dist^2: the splat is beta f cos_y D^2 / (cos_c^3 dist^2),
+ * over the light paths there are (one a sample of each pixel; add_splats
+ * divides by the samples). */
+static void to_camera(const Scene *s, const Hit *h, const Bsdf *b, vec wl, vec beta, Worker *wk)
+{
+    const Camera *c = &s->cam;
+    vec d = sub(c->eye, h->p), wc, f;
+    real dist = sqrt(dot(d, d)), D = (real)s->set.w / 2 / c->tan_half, cos_c, cos_y, t, x, y;
+    wc = scale(1 / dist, d);                    /* towards the eye */
+    cos_c = -dot(wc, c->fwd);
+    if (!(cos_c > 0)) return;                   /* behind the camera */
+    t = D / cos_c;
+    x = (real)s->set.w / 2 - t * dot(wc, c->right);
+    y = (real)s->set.h / 2 + t * dot(wc, c->up);
+    if (!(x >= 0 && y >= 0 && x < s->set.w && y < s->set.h)) return;
+    if (c->hither > 0 && (c->hither_sphere ? dist : dist * cos_c) < c->hither) return;
+    f = bsdf_eval(b, wl, wc);
+    cos_y = fabs(dot(b->n, wc));
+    if (!nonzero(f) || !(cos_y > 0)) return;
+    wk->count.shadow++;
+    if (!camera_sees(s, wc, dist, h->time, wk)) return;
+    splat(s, wk, x, y, scale(cos_y * D * D / (cos_c * cos_c * cos_c * dist * dist * ((real)s->set.w * s->set.h)),
+                             mul(beta, f)));
 }
 
 /* Russian roulette: from ROULETTE_FROM rays on, the path goes on with the
@@ -2009,17 +2193,30 @@ static void bound_lights(LightNode *k, const LightNode *a, const LightNode *b)
 static int choose_light(const Scene *s, vec x, vec n, real u, real *chance)
 {
     const Lights *L = &s->lights;
-    int k = L->root;
-    *chance = 1;
+    int k = L->root, l;
     if (L->sky >= 0 && (k < 0 || u < (real)0.5)) {
         *chance = k < 0 ? 1 : (real)0.5;
         return L->sky;
     }
+    if (L->sky >= 0) u = 2 * u - 1;
+    l = down_the_tree(s, x, n, s->set.light_choice == BY_POWER, u, chance);
+    if (L->sky >= 0) *chance *= (real)0.5;
+    return l;
+}
+
+/* Down the light tree from its root, by the weights of the halves at x
+ * (or by their power alone: light tracing, which has no point yet), the
+ * light that u picks and the chance of picking it; -1 if none. */
+static int down_the_tree(const Scene *s, vec x, vec n, int by_power, real u, real *chance)
+{
+    const Lights *L = &s->lights;
+    int k = L->root;
+    *chance = 1;
     if (k < 0) return -1;
-    if (L->sky >= 0) u = 2 * u - 1, *chance = (real)0.5;
     while (L->node[k].light < 0) {
         const int *c = L->node[k].child;
-        real a = node_weight(s, c[0], x, n), b = node_weight(s, c[1], x, n), p = a / (a + b);
+        real a = node_weight(s, c[0], x, n, by_power), b = node_weight(s, c[1], x, n, by_power);
+        real p = a / (a + b);
         if (!(a + b > 0)) return -1;
         if (u < p || !(b > 0)) u = fmin(u / p, 1), *chance *= a / (a + b), k = c[0];
         else u = fmin((u - p) / (1 - p), 1), *chance *= b / (a + b), k = c[1];
@@ -2029,10 +2226,10 @@ static int choose_light(const Scene *s, vec x, vec n, real u, real *chance)
 
 /* How much sample_light favours the lights below node k at x: what they
  * may bring there, or (--light-choice power) their power alone. */
-static real node_weight(const Scene *s, int k, vec x, vec n)
+static real node_weight(const Scene *s, int k, vec x, vec n, int by_power)
 {
     const LightNode *node = &s->lights.node[k];
-    return s->set.light_choice == BY_POWER ? node->power : importance(node, x, n);
+    return by_power ? node->power : importance(node, x, n);
 }
 
 /* What the lights below node k may bring to the point x of normal n:
@@ -2077,7 +2274,8 @@ static real light_choice(const Scene *s, int l, vec x, vec n)
     if (l == L->sky) return chance;
     for (k = L->leaf[l]; (up = L->node[k].parent) >= 0; k = up) {
         const int *c = L->node[up].child;
-        real a = node_weight(s, c[0], x, n), b = node_weight(s, c[1], x, n);
+        real a = node_weight(s, c[0], x, n, s->set.light_choice == BY_POWER);
+        real b = node_weight(s, c[1], x, n, s->set.light_choice == BY_POWER);
         if (!(a + b > 0)) return 0;
         chance *= (k == c[0] ? a : b) / (a + b);
     }
@@ -3478,10 +3676,8 @@ static int row_stride(int h)
 #define SPLAT_MAX 1048576.0         /* a larger splat is clamped: no overflow */
 
 /* Light L added to the pixel under image point (x, y), by a sample of any
- * pixel (a hook's after_sample).  Not static: nothing in ray.c calls it
- * yet (light tracing will), and the tests do. */
-void splat(const Scene *s, Worker *wk, real x, real y, vec L);
-void splat(const Scene *s, Worker *wk, real x, real y, vec L)
+ * pixel (light tracing's to_camera, or a hook's after_sample). */
+static void splat(const Scene *s, Worker *wk, real x, real y, vec L)
 {
     double c[3];
     int a, i = (int)floor(x), j = (int)floor(y);
@@ -3555,7 +3751,8 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
 {
     int k;
     int rows = s->set.y1 - s->set.y0, done = 0, stride = row_stride(rows), nthreads = 1;
-    int splats = o->hooks && o->hooks->after_sample;
+    int splats = (o->hooks && o->hooks->after_sample)
+                 || (s->set.integrator == PATH && s->set.estimator == LIGHT_TRACING);
     long long **splat = NULL;
     Tally *first;
     Image own, *into = img;
@@ -4135,6 +4332,21 @@ static void say_what_is_ignored(const Scene *s, const Args *a)
                 " numbers only for a lens, area lights, glossy rays and motion\n");
 }
 
+/* Light tracing splats into any pixel: it renders whole images, every
+ * sample, and no pixel stops early; 0 with a message otherwise. */
+static int light_tracing_can(const Scene *s, const Args *a, int all)
+{
+    const char *why = s->set.adaptive > 0 ? "--adaptive"
+                      : a->checkpoint > 0 || a->resume ? "--checkpoint and --resume"
+                      : s->set.x0 || s->set.y0 || s->set.x1 < s->set.w || s->set.y1 < s->set.h
+                        || !all || strstr(a->output, ".part") ? "a split render" : NULL;
+    if (why) fprintf(stderr, "ray: --estimator light renders whole images only: not with %s\n", why);
+    if (!why && s->lights.sky >= 0)
+        fprintf(stderr, "ray: warning: under --estimator light the sky lights nothing (no light path"
+                " starts from it); it is seen only where the camera sees it\n");
+    return !why;
+}
+
 /* The command line's choices for the path tracer (-1: not given) onto the
  * scene, and its lights; 0 with a message when they cannot work. */
 static int settle_path_options(Scene *s, int integrator, int estimator, int roulette, long seed)
@@ -4310,6 +4522,10 @@ int main(int argc, char **argv)
     if (ok && !settle_split(&s, &a, spp, &o.spp)) {
         free_scene(&s); free_args(&a);
         return 2;                   /* a part beyond the image: a usage error */
+    }
+    if (ok && s.set.integrator == PATH && s.set.estimator == LIGHT_TRACING && !light_tracing_can(&s, &a, s.set.s0 == 0 && o.spp == spp)) {
+        free_scene(&s); free_args(&a);
+        return 2;
     }
     if (ok) say_what_is_ignored(&s, &a);
     o.threads = a.threads;
