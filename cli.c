@@ -19,7 +19,8 @@
 #define REAL double         /* as ray.c is built, for --version */
 #endif
 
-/* The options, once: --help prints this, and the README shows it. */
+/* The options, once: --help prints this, and the README shows it (in two
+ * strings: C99 promises no more than 4095 characters in one). */
 void usage(FILE *to)
 {
     fputs("usage: ray [options] SCENE\n"
@@ -52,7 +53,8 @@ void usage(FILE *to)
           "             or power (by its power alone)\n"
           "  --seed N   the path tracer's noise, 0 or more (default 0): another N, other\n"
           "             noise\n"
-          "  --adaptive E  samples in doubling rounds (from 8; the path tracer's from\n"
+          , to);
+    fputs("  --adaptive E  samples in doubling rounds (from 8; the path tracer's from\n"
           "             16) up to -n: a pixel stops once its byte is known to within E\n"
           "             steps with 95% confidence, by its own samples; Whitted's also at\n"
           "             4 where its 8 neighbours' first 4 agree with its own\n"
