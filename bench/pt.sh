@@ -2,13 +2,14 @@
 # bench/pt.sh: the path tracer's time against error (make bench, part "pt";
 # also runs alone: bash bench/pt.sh).
 #
-# For the Cornell box and smallpt's scene: a reference rendered at many
-# samples (MIS, another seed, every core; kept in bench/out between runs
-# while ./ray and the scene are unchanged), then each estimator (bsdf, nee,
-# mis) at 1, 4, 16, 64 and 256 samples per pixel on one thread, each run's
-# CPU time (user + system, of the whole process) against its RMSE on
-# linear values (bench/pfmerr.c).  The three estimators take turns (bsdf
-# nee mis bsdf nee mis ...) in BENCH_PT_ROUNDS rounds at each sample count;
+# For the Cornell box, smallpt's scene and the caustic: a reference
+# rendered at many samples (MIS, another seed, every core; kept in
+# bench/out between runs while ./ray and the scene are unchanged), then
+# each estimator (bsdf, nee, mis; and light tracing on the Cornell box and
+# the caustic, see estimators_of) at 1, 4, 16, 64 and 256 samples per
+# pixel on one thread, each run's CPU time (user + system, of the whole
+# process) against its RMSE on linear values (bench/pfmerr.c).  The
+# estimators take turns (bsdf nee mis bsdf nee mis ...) in BENCH_PT_ROUNDS rounds at each sample count;
 # the time is the median of the rounds, printed with the least and the
 # greatest (the image, of a fixed seed, is the same each time).  The fitted
 # slope of log RMSE against log time is printed per estimator: -0.5 for an
@@ -28,7 +29,7 @@
 #     renderer's on the same scene (smallpt's), one thread.
 #
 # Knobs: BENCH_PT_REF_SPP (4096), BENCH_PT_SPP ("1 4 16 64 256"),
-#        BENCH_PT_SCENES ("cornell:128x128 smallpt:128x96"), BENCH_SMALLPT,
+#        BENCH_PT_SCENES ("cornell:128x128 smallpt:128x96 caustic:160x120"), BENCH_SMALLPT,
 #        BENCH_PT_ROUNDS (BENCH_ROUNDS, else 3).
 set -u -o pipefail
 export LC_ALL=C
@@ -39,7 +40,7 @@ CFLAGS=${CFLAGS:--O2}
 OUT=bench/out
 REF_SPP=${BENCH_PT_REF_SPP:-4096}
 SPPS=${BENCH_PT_SPP:-1 4 16 64 256}
-SCENES=${BENCH_PT_SCENES:-cornell:128x128 smallpt:128x96}
+SCENES=${BENCH_PT_SCENES:-cornell:128x128 smallpt:128x96 caustic:160x120}
 SMALLPT=${BENCH_SMALLPT:-}
 ROUNDS=${BENCH_PT_ROUNDS:-${BENCH_ROUNDS:-3}}
 mkdir -p "$OUT"
@@ -52,6 +53,15 @@ LOG=pt
 . bench/lib.sh
 build_time_tools || die "cannot build ray, pfmerr, svgplot or table"
 RAY=$OUT/ray_pt
+
+# estimators_of NAME: the estimators that take turns on a scene: light
+# tracing (--estimator light) too where the camera sees no diffuse
+# surface through glass or a mirror, which it cannot render (smallpt's
+# balls), or where it is the point (the caustic's floor; its ball, black
+# to light tracing, is then its error).
+estimators_of() {
+  case $1 in cornell|caustic) echo bsdf nee mis light ;; *) echo bsdf nee mis ;; esac
+}
 
 # reference NAME SIZE: MIS at $REF_SPP spp, seed 99 (the runs use seed 0:
 # a reference sharing their random numbers would share their noise).
@@ -88,13 +98,13 @@ for item in $SCENES; do
   for spp in $SPPS; do
     declare -A times=()
     for ((round = 1; round <= ROUNDS; round++)); do
-      for est in bsdf nee mis; do
+      for est in $(estimators_of "$name"); do
         cpu "$RAY" --pt -t 1 --estimator "$est" -s "$size" -n "$spp" -o "$OUT/pt-$name-$est-$spp.pfm" "scenes/$name.sph" ||
           die "failed: $name $est $spp"
         times[$est]+="$cpu "
       done
     done
-    for est in bsdf nee mis; do
+    for est in $(estimators_of "$name"); do
       record "$OUT/pt.tsv" "$name" "$size" "$est" "$spp" "$OUT/pt-$name-$est-$spp.pfm" "$ref" "${times[$est]}"
       # target 1's figures (below): the Cornell box's first BSDF run at 256 spp
       if [ "$name/$est/$spp" = cornell/bsdf/256 ] && [ -z "$e_b" ]; then
