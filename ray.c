@@ -1814,7 +1814,7 @@ static void trace_light_path(const Scene *s, int i, int j, int k, real time, Wor
         bsdf_at(s, &h, wl, &b);
         to_camera(s, &h, &b, wl, beta, wk);
         if (rays == most || sample_bsdf(&b, wl, wk, &wi, &f_cos_pdf, &pdf) < 0) return;
-        beta = mul(beta, f_cos_pdf);
+        beta = mul(beta, f_cos_pdf);            /* f cos / pdf of the bounce */
         if (!survives(s, rays, &beta, &f_cos_pdf, wk)) return;
         r = spawn(s, &h, wi);
     }

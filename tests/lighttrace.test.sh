@@ -8,7 +8,9 @@
 # over the whole image within 4.  Scenes: the Cornell box (triangle lamp,
 # every bounce), a large one-sided lamp close over a floor (lamp.sph,
 # direct light), a glowing sphere over a ball on a floor (soft.sph), and
-# point lights over diffuse balls; and a moving lamp at the shutter's one
+# point lights over diffuse balls, a two-sided triangle lamp over a floor,
+# lamps seen only directly, through a glass ball and in a mirror ball
+# (nothing diffuse: the camera's half alone); and a moving lamp at the shutter's one
 # instant against the lamp put there.  The same bytes on 1 and 3 threads;
 # split renders and --adaptive refused.
 . tests/lib.sh
@@ -23,6 +25,23 @@ tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
 0 0 1          .85 .35 .25   1      .8 0 0 0 1
 2 -1 .6        .3 .8 .4      .6     .7 0 0 0 1
 SCENE
+cat >"$TMP/twosided.sph" <<'SCENE'
+integrator path
+background 0 0 0
+camera 0 -8 3   0 0 1   0 0 1   50
+tri -9 -9 0  9 -9 0  9 9 0     .8 .8 .8  .8 0 0 0 1
+tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
+tri -2 1 1  2 1 1  0 1 4     1 .9 .7  0 0 0 3 1
+SCENE
+cat >"$TMP/seen.sph" <<'SCENE'
+integrator path
+background 0 0 0
+camera 0 -8 2   0 0 1.5   0 0 1   40
+0 3 2       1 .9 .7      1.2    0 0 0 4 1
+-1.2 0 1.2  1 1 1        .9     0 0 1 0 1.5
+1.4 0 1.6   1 1 1        .8     0 1 0 0 1
+tri -4 6 0  4 6 0  0 6 5     .5 .7 1  0 0 0 2 1
+SCENE
 blocks() {   # the worst block's z and the whole image's, of image $2 minus image $1 (w x h)
   python3 -c "$PFM_PY
 a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
@@ -35,10 +54,11 @@ worst = max(abs(z([(y * h // 4 + j) * w + x * w // 4 + i for j in range(h // 4) 
             for y in range(4) for x in range(4))
 print('%.2f %.2f' % (worst, z(range(w * h))))" "$1" "$2" "$3" "$4"
 }
-for r in "cornell.sph -n 256" "lamp.sph -n 64 -d 2" "soft.sph --pt -n 128 -d 3" "points.sph -n 64 -d 3"; do
+for r in "cornell.sph -n 256" "lamp.sph -n 64 -d 2" "soft.sph --pt -n 128 -d 3" "points.sph -n 64 -d 3" \
+         "twosided.sph -n 64 -d 3" "seen.sph -n 64 -d 6"; do
   set -- $r
   f=$1; shift
-  scene=scenes/$f; [ "$f" = points.sph ] && scene=$TMP/points.sph
+  scene=scenes/$f; [ -f "$TMP/$f" ] && scene=$TMP/$f
   ./ray "$scene" "$@" -s 32x32 --seed 3 -o "$TMP/mis.pfm" 2>/dev/null
   ./ray "$scene" "$@" -s 32x32 --seed 4 --estimator light -o "$TMP/light.pfm" 2>/dev/null
   read -r worst whole <<<"$(blocks "$TMP/mis.pfm" "$TMP/light.pfm" 32 32)"
