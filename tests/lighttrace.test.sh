@@ -39,8 +39,9 @@ background 0 0 0
 camera 0 -8 2   0 0 1.5   0 0 1   40
 0 3 2       1 .9 .7      1.2    0 0 0 4 1
 -1.2 0 1.2  1 1 1        .9     0 0 1 0 1.5
-1.4 0 1.6   1 1 1        .8     0 1 0 0 1
+1.4 0 1.6   1 1 1        .8     0 .4 0 0 1
 tri -4 6 0  4 6 0  0 6 5     .5 .7 1  0 0 0 2 1
+0 -16 3     1 1 1        5      0 0 0 1 1
 SCENE
 blocks() {   # the worst block's z and the whole image's, of image $2 minus image $1 (w x h)
   python3 -c "$PFM_PY
