@@ -11,3 +11,7 @@ done
 # the light tree against choosing by power, at the same 16 samples (the README's "Many lights")
 ./ray -n 16 --light-choice power -o docs/pt/lights100-power.png scenes/lights100.sph
 ./ray -n 16 -o docs/pt/lights100-tree.png scenes/lights100.sph
+# light tracing beside MIS (the README's "Light tracing")
+./ray -s 256x256 -n 32 -o docs/pt/cornell-mis32.png scenes/cornell.sph
+./ray -s 256x256 -n 32 --estimator light -o docs/pt/cornell-light.png scenes/cornell.sph
+./ray -s 320x240 -n 64 --estimator light -o docs/pt/caustic-light.png scenes/caustic.sph
