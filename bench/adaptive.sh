@@ -26,8 +26,6 @@ SCENES=${BENCH_ADAPTIVE_SCENES:-scenes/whitted.sph:320x240 scenes/spd/balls_s4.n
 REF_SPP=${BENCH_ADAPTIVE_REF_SPP:-256}
 RUNS=${BENCH_ADAPTIVE_RUNS:--n 16;-n 32 --adaptive 12;-n 64 --adaptive 16;-n 64 --adaptive 2;-n 64 --adaptive 0.5}
 ROUNDS=${BENCH_ROUNDS:-3}
-mkdir -p "$OUT"
-die() { echo "bench/adaptive.sh: $*" >&2; exit 1; }
 LOG=adaptive
 . bench/lib.sh
 build_time_tools || die "cannot build ray or the table tool"

@@ -28,9 +28,6 @@ REF_SPP=${BENCH_DIST_REF_SPP:-1024}
 SPPS=${BENCH_DIST_SPP:-1 4 16 64}
 SCENES=${BENCH_DIST_SCENES:-dof:160x80 soft:160x120 glossy:160x80 motion:160x120}
 ROUNDS=${BENCH_DIST_ROUNDS:-${BENCH_ROUNDS:-3}}
-mkdir -p "$OUT"
-die() { echo "bench/dist.sh: $*" >&2; exit 1; }
-say() { echo "bench: $*" >&2; }
 LOG=dist
 . bench/lib.sh
 build_time_tools || die "cannot build ray, pfmerr, svgplot or table"

@@ -8,6 +8,12 @@
 # "least-greatest", each in FORMAT (printf's); ratios "A1 A2 ..." "B1 B2
 # ...": A1/B1 A2/B2 ..., the pairs' ratios; ratio FORMAT A B: one;
 # verdict A OP B: "met" or "NOT MET".
+# die MESSAGE: the script's name and MESSAGE on stderr, exit 1; say: a
+# progress line.  And $OUT made, for the script that sources this.
+die() { echo "$0: $*" >&2; exit 1; }
+say() { echo "bench: $*" >&2; }
+mkdir -p "$OUT" || die "cannot create $OUT"
+
 table() { "$OUT/table" "$@"; }
 kv() { table kv "$@"; }
 spread() { table spread "$@"; }

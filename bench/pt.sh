@@ -43,9 +43,6 @@ SPPS=${BENCH_PT_SPP:-1 4 16 64 256}
 SCENES=${BENCH_PT_SCENES:-cornell:128x128 smallpt:128x96 caustic:160x120}
 SMALLPT=${BENCH_SMALLPT:-}
 ROUNDS=${BENCH_PT_ROUNDS:-${BENCH_ROUNDS:-3}}
-mkdir -p "$OUT"
-die() { echo "bench/pt.sh: $*" >&2; exit 1; }
-say() { echo "bench: $*" >&2; }
 
 # The arithmetic and the tables are bench/table.c's, as in bench/run.sh;
 # bench/lib.sh names its subcommands, builds the tools and times a run.

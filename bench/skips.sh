@@ -39,9 +39,6 @@ light tree (--light-choice)|scenes/lights100.sph|320x240|-n 16|--light-choice po
 Sobol' samples (--sampler)|scenes/cornell.sph|128x128|-n 64 --sampler sobol|--sampler independent|64 128 256
 Russian roulette|scenes/cornell.sph|128x128|-d 16 -n 64|-d 16 --no-roulette|32 64 128 256
 path tracer adaptive|scenes/cornell.sph|128x128|-n 256 --adaptive 4||64 128 256"}
-mkdir -p "$OUT"
-die() { echo "bench/skips.sh: $*" >&2; exit 1; }
-say() { echo "bench: $*" >&2; }
 LOG=skips
 . bench/lib.sh
 build_time_tools || die "cannot build ray, pfmerr, svgplot or table"
@@ -116,6 +113,7 @@ done <<<"$ROWS"
 echo "(ratio: with's time over without's at the same RMSE; under 1, the skip pays)" | tee -a "$OUT/skips.txt"
 
 # the plot: each row's with and without, time against error
+[ -s "$OUT/skips.tsv" ] || exit 0                # every row skipped: nothing to plot
 sed 's/^\([0-9]*\)\t/row\1\t/' "$OUT/skips.tsv" >"$OUT/skips-plot.tsv"
 table pt-plot "$OUT/skips-plot.tsv" |
   "$OUT/svgplot" --title "make bench: every skip at equal error (row/with, row/without; labels: samples per pixel)" \
