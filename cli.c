@@ -42,8 +42,12 @@ void usage(FILE *to)
           "             (default: the scene's `integrator`, else Whitted)\n"
           "  --estimator E  the path tracer's: bsdf (BSDF sampling only), nee (next-event\n"
           "             estimation), mis (both, by multiple importance sampling; default)\n"
-          "             or light (light tracing: paths from the lights, joined to the\n"
-          "             camera; whole images only, no --adaptive)\n"
+          "             light (light tracing: paths from the lights, joined to the\n"
+          "             camera) or bdpt (bidirectional path tracing: a path from the\n"
+          "             camera and one from a light, joined every way, weighed by MIS);\n"
+          "             light and bdpt: whole images only, no --adaptive, no lens\n"
+          "  --strategy S,T  bdpt: only the paths made of S vertices from the light and\n"
+          "             T from the camera, weighed as in the whole (S >= 0, T >= 1)\n"
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
           "  --sampler S  the path tracer's numbers: independent (a hash of the sample\n"
           "             and the dimension; default) or sobol (Owen-scrambled Sobol'\n"
@@ -206,6 +210,18 @@ static void split_arg(Args *a, const char *opt, const char *v)
     }
 }
 
+/* --strategy S,T: S vertices from the light, T from the camera; the
+ * camera's end is always there (T >= 1), and a path has a ray (S + T >= 2). */
+static void strategy_arg(Args *a, const char *v)
+{
+    numbers_arg("--strategy", v, ",", 2, "S,T, vertices from the light and from the camera", a->strategy);
+    if (a->strategy[1] < 1 || a->strategy[0] + a->strategy[1] < 2) {
+        fprintf(stderr, "ray: --strategy %s: T must be 1 or more (the camera's vertex), and S + T"
+                " 2 or more (a path has a ray)\n", v);
+        exit(2);
+    }
+}
+
 /* A number of seconds above 0, or exit with a message. */
 static double seconds_arg(const char *opt, const char *arg)
 {
@@ -248,9 +264,11 @@ static int estimator_arg(const char *v)
     if (!strcmp(v, "bsdf")) return 0;
     if (!strcmp(v, "nee")) return 1;
     if (!strcmp(v, "light")) return 3;
+    if (!strcmp(v, "bdpt")) return 4;
     if (strcmp(v, "mis")) {
         fprintf(stderr, "ray: --estimator takes bsdf (BSDF sampling only), nee (next-event"
-                " estimation), mis or light (light tracing), not %s\n", v);
+                " estimation), mis, light (light tracing) or bdpt (bidirectional path tracing),"
+                " not %s\n", v);
         exit(2);
     }
     return 2;
@@ -377,6 +395,7 @@ int parse_args(int argc, char **argv, Args *a)
     int i;
     memset(a, 0, sizeof *a);
     a->integrator = a->estimator = a->sampler = a->light_choice = -1;
+    a->strategy[0] = a->strategy[1] = -1;
     a->roulette = 1;
     a->seed = -1;
     for (i = 1; i < argc; i++) {
@@ -403,6 +422,7 @@ int parse_args(int argc, char **argv, Args *a)
         else if ((v = option_value(argc, argv, &i, "--adaptive"))) a->adaptive = steps_arg("--adaptive", v);
         else if ((v = option_value(argc, argv, &i, "--sampler"))) a->sampler = sampler_arg(v);
         else if ((v = option_value(argc, argv, &i, "--light-choice"))) a->light_choice = light_choice_arg(v);
+        else if ((v = option_value(argc, argv, &i, "--strategy"))) strategy_arg(a, v);
         else if ((v = option_value(argc, argv, &i, "--crop"))) split_arg(a, "--crop", v);
         else if ((v = option_value(argc, argv, &i, "--tile"))) split_arg(a, "--tile", v);
         else if ((v = option_value(argc, argv, &i, "--samples"))) split_arg(a, "--samples", v);
@@ -448,7 +468,7 @@ static unsigned long long all_rays(const Stats *st)
 /* --stats=kv: for programs to read (bench/run.sh does). */
 static void print_stats_kv(FILE *f, const Stats *st)
 {
-    static const char *const estimators[] = { "bsdf", "nee", "mis", "light" };
+    static const char *const estimators[] = { "bsdf", "nee", "mis", "light", "bdpt" };
     fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
             st->spheres, st->cones, st->triangles, st->point_lights, st->glowing);
     fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", st->w, st->h, st->spp,
@@ -516,7 +536,8 @@ void print_stats(FILE *f, const Stats *st, int kv)
 {
     static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
                                               "MIS (BSDF sampling and next-event estimation)",
-                                              "light tracing (paths from the lights, to the camera)" };
+                                              "light tracing (paths from the lights, to the camera)",
+                                              "bidirectional path tracing (MIS over every join)" };
     unsigned long long rays = all_rays(st);
     if (kv) {
         print_stats_kv(f, st);

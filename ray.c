@@ -222,6 +222,7 @@ enum { POINT_LIGHT, SPHERE_LIGHT, TRIANGLE_LIGHT, SKY_LIGHT };
 typedef struct {
     int type, obj;
     vec pos, intensity;       /* a point light's place and intensity I (radiance: I / d^2) */
+    int inward;               /* a sphere that light paths leave inward too (see inside_seen) */
 } Emitter;
 
 /* A Scene holds four things, each of its own: what the file describes
@@ -237,7 +238,8 @@ typedef struct {
     int depth;                /* Whitted: the recursion's depth */
     int max_rays;             /* path tracing: rays on a path at most (-d); 0: no bound but roulette */
     int spp;                  /* samples per pixel the scene asks for (0: none said) */
-    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS or LIGHT_TRACING */
+    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS, LIGHT_TRACING or BDPT */
+    int strategy[2];          /* --strategy S,T: BDPT's one strategy shown ({-1, -1}: all) */
     int roulette;             /* 1: Russian roulette ends paths */
     unsigned seed;            /* --seed: which noise */
     int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, or 0 */
@@ -325,7 +327,7 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
  * only, by next-event estimation, or by both weighed by MIS. */
 enum { WHITTED, PATH };
 enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
-enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING };
+enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT };
 enum { INDEPENDENT, SOBOL };
 enum { BY_IMPORTANCE, BY_POWER };
 
@@ -536,6 +538,13 @@ static int refract(vec d, vec n, real cosi, real eta, vec *t);
 /* L = Le + integral f L cos: Kajiya's path tracing */
 typedef struct Path Path;
 typedef struct Bsdf Bsdf;
+typedef struct Vertex Vertex;
+/* Where a light path starts (emit_ray): the light's normal there (a point
+ * light's: the direction it sent), what it emits (an area light's
+ * radiance Le, a point light's intensity), and the pdfs of the point (per
+ * area; 1 for a point light) and of the direction (per solid angle), which
+ * bidirectional path tracing weighs its strategies with. */
+typedef struct { vec n, emit; real pdf_point, pdf_dir; } Start;
 static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk);
 static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk);
 static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk);
@@ -543,14 +552,35 @@ static int survives(const Scene *s, int rays, vec *beta, vec *f_cos_pdf, Worker 
 static vec seen_directly(const Scene *s, Ray r, Worker *wk);
 static void splat(const Scene *s, Worker *wk, real x, real y, vec L);
 static void trace_light_path(const Scene *s, int i, int j, int k, real time, Worker *wk);
-static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta);
+static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta, Start *from);
+static real light_area(const Scene *s, int l);
 static void to_camera(const Scene *s, const Hit *h, const Bsdf *b, vec wl, vec beta, Worker *wk);
+static int onto_film(const Scene *s, vec p, vec *wc, real *dist, real *x, real *y, real *pdf);
 static int camera_sees(const Scene *s, vec wc, real dist, real time, Worker *wk);
+static vec bdpt(const Scene *s, Ray r, Worker *wk);
+static int chosen(const Scene *s, int k, int t);
+typedef struct Subpaths Subpaths;
+static int subpaths(const Scene *s, Ray r, Subpaths *p, Worker *wk);
+static int walk(const Scene *s, Ray r, vec beta, real pdf, int most, int first, Vertex *v, Worker *wk,
+                int *escaped);
+static int light_subpath(const Scene *s, real time, Subpaths *p, Worker *wk);
+static real to_area(real pdf, vec from, const Hit *to);
+static real film_pdf(const Scene *s, vec d);
+static vec met_light(const Scene *s, const Subpaths *p, int t);
+static vec to_light(const Scene *s, const Subpaths *p, int t, Worker *wk);
+static vec light_normal(const Scene *s, int l, vec y, real time);
+static void to_eye(const Scene *s, const Subpaths *p, int k, Worker *wk);
+static vec join(const Scene *s, const Subpaths *p, int k, int t, Worker *wk);
+typedef struct Rev Rev;
+static Rev join_rev(const Subpaths *p, int k, int t, vec wi);
+static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev, int point);
+static real nz(real pdf);
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
 static vec sample_light(const Scene *s, const Hit *h, const Bsdf *b, vec wo, Worker *wk);
 static void prepare_lights(Scene *s);
+static int inside_seen(const Scene *s, int i);
 static int light_tree(Lights *L, int *order, int n, int parent);
 static void split_lights(const Lights *L, int *order, int n, int m, int a);
 static void bound_lights(LightNode *k, const LightNode *a, const LightNode *b);
@@ -561,6 +591,7 @@ static real node_weight(const Scene *s, int k, vec x, vec n, int by_power);
 static int down_the_tree(const Scene *s, vec x, vec n, int by_power, real u, real *chance);
 static int choose_light(const Scene *s, vec x, vec n, real u, real *chance);
 static real light_choice(const Scene *s, int l, vec x, vec n);
+static real tree_chance(const Scene *s, int l, vec x, vec n, int by_power);
 static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u, real v,
                           vec *wi, real *dist, vec *Le, real *pdf);
 static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist, Worker *wk);
@@ -1705,6 +1736,7 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
         trace_light_path(s, i, j, k, r.time, wk);
         return L;
     }
+    if (s->set.estimator == BDPT) return bdpt(s, r, wk);
     return radiance(s, r, &path, wk);
 }
 
@@ -1797,11 +1829,12 @@ static void trace_light_path(const Scene *s, int i, int j, int k, real time, Wor
     Ray r;
     vec beta;
     real chance;
+    Start from;
     int l, rays, most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
     start_sample(wk, s, i, j, k);
     wk->bounce = LIGHT_PATH;
     l = down_the_tree(s, v3(0, 0, 0), v3(0, 0, 0), 1, bounce_random(wk, LIGHT_CHOICE), &chance);
-    if (l < 0 || !emit_ray(s, l, time, wk, &r, &beta)) return;
+    if (l < 0 || !emit_ray(s, l, time, wk, &r, &beta, &from)) return;
     beta = scale(1 / chance, beta);
     for (rays = 2; rays <= most; rays++) {     /* the line to the camera is ray number `rays` */
         Hit h;
@@ -1824,46 +1857,72 @@ static void trace_light_path(const Scene *s, int i, int j, int k, real time, Wor
  * from this bounce's numbers, and what it carries, Le cos / pdf: from a
  * point light of intensity I, sent the same way in every direction
  * (pdf 1 / 4 pi), 4 pi I; from a point of an emitting sphere or triangle
- * of area A (each side of a two-sided one counted), sent by the cosine
- * (pdf cos / pi), pi A Le.  0 when nothing can leave. */
-static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta)
+ * of area A (each side of a two-sided one counted: light_area), sent by
+ * the cosine (pdf cos / pi), pi A Le.  *from gets the light's normal at
+ * the start and the two pdfs, which bidirectional path tracing weighs
+ * with.  0 when nothing can leave. */
+static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta, Start *from)
 {
     const Emitter *e = &s->lights.emit[l];
     const Material *m;
-    real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V), area;
+    real u = bounce_random(wk, LIGHT_U), v = bounce_random(wk, LIGHT_V), area = light_area(s, l);
     vec n, local = cosine_hemisphere(bounce_random(wk, DIRECTION_U), bounce_random(wk, DIRECTION_V));
-    int k, what;
+    int k, what, inward = 0;
     r->tmin = 0, r->time = time, r->skip = -1;
     if (e->type == POINT_LIGHT) {
         real z = 1 - 2 * u, rho = sqrt(fmax(0, 1 - z * z));
         r->o = e->pos;
-        r->d = v3(rho * cos(2 * PI * v), rho * sin(2 * PI * v), z);
+        r->d = from->n = v3(rho * cos(2 * PI * v), rho * sin(2 * PI * v), z);
+        from->pdf_point = 1, from->pdf_dir = 1 / (4 * (real)PI);
+        from->emit = e->intensity;
         *beta = scale(4 * (real)PI, e->intensity);
         return 1;
     }
-    if (e->type != SPHERE_LIGHT && e->type != TRIANGLE_LIGHT) return 0;
+    if (!(area > 0)) return 0;
     what = kind(s, e->obj, &k);
     if (what == SPHERE) {
         real z = 1 - 2 * u, rho = sqrt(fmax(0, 1 - z * z));
         n = v3(rho * cos(2 * PI * v), rho * sin(2 * PI * v), z);
         r->o = comb(s->sph[k].rad, n, s->sph[k].cen);
-        area = 4 * (real)PI * s->sph[k].rad * s->sph[k].rad;
         m = &s->mat[s->sph[k].mat];
-    } else {
-        vec c = cross(s->tri[k].e1, s->tri[k].e2);
-        triangle_sample(&s->tri[k], u, v, &r->o, &n);
-        area = sqrt(dot(c, c)) / 2;
-        if (!s->tri[k].cull) {                  /* either side, half the time each */
-            if (bounce_random(wk, LOBE) < (real)0.5) n = scale(-1, n);
-            area *= 2;
+        inward = e->inward && bounce_random(wk, LOBE) < (real)0.5;    /* half the time, if at all */
+        if (inward) {                           /* off the surface, as spawn() leaves a hit */
+            r->o = comb(-64 * REAL_EPS * (maxabs(r->o) + maxabs(s->sph[k].cen) + s->sph[k].rad), n, r->o);
+            n = scale(-1, n);
         }
+    } else {
+        triangle_sample(&s->tri[k], u, v, &r->o, &n);
+        if (!s->tri[k].cull && bounce_random(wk, LOBE) < (real)0.5) n = scale(-1, n);   /* either side */
         m = &s->mat[s->tri[k].mat];
     }
     if (moves(s, e->obj)) r->o = comb(time, velocity(s, e->obj), r->o);
     r->d = from_local(n, local);
-    r->skip = e->obj;                           /* it leaves the surface outward */
+    r->skip = inward ? -1 : e->obj;             /* leaving outward, it cannot meet the surface again */
+    from->n = n;
+    from->pdf_point = 1 / area, from->pdf_dir = cosine_hemisphere_pdf(local.z);
+    from->emit = scale(m->kl, m->color);
     *beta = scale((real)PI * area * m->kl, m->color);
     return 1;
+}
+
+/* The area light l emits from: a sphere's, or a triangle's, twice that
+ * when light paths leave it from both sides; 0 for a point light, the sky
+ * or a degenerate triangle. */
+static real light_area(const Scene *s, int l)
+{
+    const Emitter *e = &s->lights.emit[l];
+    int k;
+    if (e->type == SPHERE_LIGHT) {
+        kind(s, e->obj, &k);
+        return 4 * (real)PI * s->sph[k].rad * s->sph[k].rad * (e->inward ? 2 : 1);
+    }
+    if (e->type == TRIANGLE_LIGHT) {
+        vec c;
+        kind(s, e->obj, &k);
+        c = cross(s->tri[k].e1, s->tri[k].e2);
+        return sqrt(dot(c, c)) / 2 * (s->tri[k].cull ? 1 : 2);
+    }
+    return 0;
 }
 
 /* Whether the camera sees the point that lies dist from it the other way
@@ -1883,34 +1942,391 @@ static int camera_sees(const Scene *s, vec wc, real dist, real time, Worker *wk)
 
 /* What vertex h of a light path, reached from direction wl with
  * throughput beta, sends to the camera, into the pixel the line to the
- * eye crosses.  The pinhole's image plane stands D = w / (2 tan(fov / 2))
- * pixels from the eye, so a pixel's radiance is the integral of L over
- * its solid angle times D^2 / cos^3 (the plane's area against the solid
- * angle it fills), and the solid angle of the surface around h is
- * cos_y dA / dist^2: the splat is beta f cos_y D^2 / (cos_c^3 dist^2),
- * over the light paths there are (one a sample of each pixel; add_splats
- * divides by the samples). */
+ * eye crosses (onto_film): beta f cos_y pdf / dist^2, the light that
+ * leaves h towards the eye times how densely the camera's rays cover the
+ * surface around h, over the light paths there are (one a sample of each
+ * pixel; add_splats divides by the samples). */
 static void to_camera(const Scene *s, const Hit *h, const Bsdf *b, vec wl, vec beta, Worker *wk)
 {
-    const Camera *c = &s->cam;
-    vec d = sub(c->eye, h->p), wc, f;
-    real dist = sqrt(dot(d, d)), D = (real)s->set.w / 2 / c->tan_half, cos_c, cos_y, t, x, y;
-    wc = scale(1 / dist, d);                    /* towards the eye */
-    cos_c = -dot(wc, c->fwd);
-    if (!(cos_c > 0)) return;                   /* behind the camera */
-    t = D / cos_c;
-    x = (real)s->set.w / 2 - t * dot(wc, c->right);
-    y = (real)s->set.h / 2 + t * dot(wc, c->up);
-    if (!(x >= 0 && y >= 0 && x < s->set.w && y < s->set.h)) return;
-    if (c->hither > 0 && (c->hither_sphere ? dist : dist * cos_c) < c->hither) return;
+    vec wc, f;
+    real dist, x, y, pdf, cos_y;
+    if (!onto_film(s, h->p, &wc, &dist, &x, &y, &pdf)) return;
     f = bsdf_eval(b, wl, wc);
     cos_y = fabs(dot(b->n, wc));
     if (!nonzero(f) || !(cos_y > 0)) return;
     wk->count.shadow++;
     if (!camera_sees(s, wc, dist, h->time, wk)) return;
-    splat(s, wk, x, y, scale(cos_y * D * D / (cos_c * cos_c * cos_c * dist * dist * ((real)s->set.w * s->set.h)),
-                             mul(beta, f)));
+    splat(s, wk, x, y, scale(cos_y * pdf / (dist * dist), mul(beta, f)));
 }
+
+/* Where the point p lands on the film: the direction wc from p to the
+ * eye, the distance, the image position (x, y) in pixels, and the pdf per
+ * solid angle with which a camera sample sends its ray through it, with
+ * the samples spread evenly over the whole image.  The pinhole's image
+ * plane stands D = w / (2 tan(fov / 2)) pixels from the eye, and a patch
+ * of it of area dA fills the solid angle cos_c^3 dA / D^2 (cos_c: the
+ * ray's angle to the view axis), so the pdf is D^2 / (cos_c^3 w h).  0
+ * when p lies behind the camera, off the image or before the near clip. */
+static int onto_film(const Scene *s, vec p, vec *wc, real *dist, real *x, real *y, real *pdf)
+{
+    const Camera *c = &s->cam;
+    vec d = sub(c->eye, p);
+    real D = (real)s->set.w / 2 / c->tan_half, cos_c, t;
+    *dist = sqrt(dot(d, d));
+    *wc = scale(1 / *dist, d);                  /* towards the eye */
+    cos_c = -dot(*wc, c->fwd);
+    if (!(cos_c > 0)) return 0;                 /* behind the camera */
+    t = D / cos_c;
+    *x = (real)s->set.w / 2 - t * dot(*wc, c->right);
+    *y = (real)s->set.h / 2 + t * dot(*wc, c->up);
+    if (!(*x >= 0 && *y >= 0 && *x < s->set.w && *y < s->set.h)) return 0;
+    if (c->hither > 0 && (c->hither_sphere ? *dist : *dist * cos_c) < c->hither) return 0;
+    *pdf = D * D / (cos_c * cos_c * cos_c * ((real)s->set.w * s->set.h));
+    return 1;
+}
+
+/* ------------------------------------------------ bidirectional path tracing */
+
+/* Bidirectional path tracing (--estimator bdpt: Veach and Guibas,
+ * "Bidirectional estimators for light transport", Eurographics Rendering
+ * Workshop 1994; Veach's thesis, 1997, chapter 10).  A sample traces two
+ * subpaths: z_0 z_1 ... from the eye, as the path tracer does, and
+ * y_0 y_1 ... from a light chosen by its power, as light tracing does.
+ * Any prefix y_0 .. y_{s-1} of the one joined by a line to a prefix
+ * z_0 .. z_{t-1} of the other is a path from the light to the eye:
+ * strategy (s, t).  A path of k rays can be made in k + 1 such ways: by
+ * the camera's subpath meeting a light (s = 0), by next-event estimation
+ * from it (s = 1), by light tracing (t = 1), or by a line between the
+ * two subpaths' middles.  Each estimate is weighed by the power heuristic
+ * over all the ways its path could have been made (mis_weight: Veach and
+ * Guibas 1995), so that each way counts where it samples best: the lamp's
+ * light on the walls by s = 1, the caustic on the floor by t = 1, the
+ * lamp seen through the glass ball by s = 0.  Those with t >= 2 belong to
+ * the pixel the sample started in; those with t = 1 are splatted where
+ * they land, as light tracing's are.  The sky is found only by the
+ * camera's subpath (no light path starts from it), with weight 1. */
+#define HALF_PATH 256       /* vertices of one subpath at most: a path under roulette
+                             * reaches it with odds below 0.95^250 */
+
+/* One vertex of a subpath: its hit and BSDF, the direction back along the
+ * subpath, the throughput that reached it (its own f not included), and
+ * its pdf per area twice: as its own subpath made it (fwd), and as the
+ * other subpath would have, walking on through it the other way (rev).
+ * delta: its subpath left it by a mirror or glass, so that no line can
+ * join there.  The eye is z_0 (its point alone); the light's point is
+ * y_0, with the light's normal as n and ng, and Le / pdf as beta. */
+struct Vertex {
+    Hit h;
+    Bsdf b;
+    vec wo, beta;
+    real fwd, rev;
+    int delta;
+};
+
+/* A sample's two subpaths: z[0 .. nz-1] from the eye and y[0 .. ny-1]
+ * from a light, each at most most_z and most_y vertices long (a path has
+ * -d rays at most, the line between them included); point: y_0 is a point
+ * light, which no subpath from the eye can meet. */
+struct Subpaths {
+    Vertex z[HALF_PATH], y[HALF_PATH];
+    int nz, ny, most_z, most_y, point;
+};
+
+/* The pdfs per area a join sets anew, where the other subpath now leads:
+ * of z_{t-1} and z_{t-2} made from the light's side, and of y_{s-1} and
+ * y_{s-2} from the eye's. */
+struct Rev { real z1, z2, y1, y2; };
+
+/* One sample of BDPT through the camera ray r: the two subpaths, then every
+ * strategy (s, t) a path of at most -d rays allows, or --strategy's one. */
+static vec bdpt(const Scene *s, Ray r, Worker *wk)
+{
+    Subpaths p;
+    vec L = v3(0, 0, 0);
+    int most = s->set.max_rays ? s->set.max_rays : MAX_PATH, t, k;
+    if (subpaths(s, r, &p, wk) && chosen(s, 0, p.nz + 1)) L = mul(p.z[p.nz].beta, s->background);
+    for (t = 1; t <= p.nz; t++)
+        for (k = 0; k <= (t == 1 || p.ny > 1 ? p.ny : 1) && k + t - 1 <= most; k++) {
+            if (k + t < 2 || !chosen(s, k, t)) continue;
+            if (t == 1) to_eye(s, &p, k, wk);
+            else if (k == 0) L = add(L, met_light(s, &p, t));
+            else if (k == 1) L = add(L, to_light(s, &p, t, wk));   /* needs no light subpath */
+            else L = add(L, join(s, &p, k, t, wk));
+        }
+    return L;
+}
+
+/* The two subpaths of a sample into *p: the eye's along the camera ray r,
+ * then the light's.  1 when the eye's last ray left the scene (the sky's
+ * light: p->z[p->nz].beta times the background). */
+static int subpaths(const Scene *s, Ray r, Subpaths *p, Worker *wk)
+{
+    int most = s->set.max_rays ? s->set.max_rays : MAX_PATH, escaped;
+    p->most_z = most + 1 < HALF_PATH ? most + 1 : HALF_PATH;
+    p->most_y = most < HALF_PATH ? most : HALF_PATH;
+    memset(&p->z[0], 0, sizeof p->z[0]);
+    p->z[0].h.p = r.o;
+    p->nz = walk(s, r, v3(1, 1, 1), film_pdf(s, r.d), p->most_z, -1, p->z, wk, &escaped);
+    p->ny = light_subpath(s, r.time, p, wk);
+    return escaped;
+}
+
+/* Whether strategy (k, t) counts: every one, or --strategy's alone. */
+static int chosen(const Scene *s, int k, int t)
+{
+    return s->set.strategy[0] < 0 || (s->set.strategy[0] == k && s->set.strategy[1] == t);
+}
+
+/* A subpath's walk from v[0] along r, a ray its side sent with the pdf
+ * (per solid angle) pdf, carrying the throughput beta.  At each hit a
+ * vertex: its pdf per area (fwd), then a direction from its BSDF, which
+ * gives the vertex before it its pdf from this side (rev); on until the
+ * BSDF or roulette ends the walk, a ray leaves the scene (*escaped, with
+ * v[n].beta what it carries) or there are most vertices.  Vertex n draws
+ * from bounce block first + n: the camera's, the path tracer's blocks; a
+ * light's, light tracing's.  Returns how many vertices there are. */
+static int walk(const Scene *s, Ray r, vec beta, real pdf, int most, int first, Vertex *v, Worker *wk,
+                int *escaped)
+{
+    int n;
+    *escaped = 0;
+    for (n = 1; n < most; n++) {
+        Vertex *cur = &v[n], *prev = &v[n - 1];
+        vec wi, f_cos_pdf;
+        int lobe;
+        cur->beta = beta;
+        if (!nearest_hit(s, r, &cur->h, wk)) { *escaped = 1; return n; }
+        cur->wo = scale(-1, r.d);
+        cur->fwd = to_area(pdf, prev->h.p, &cur->h);
+        cur->rev = 0;
+        cur->delta = 0;
+        bsdf_at(s, &cur->h, cur->wo, &cur->b);
+        if (n + 1 == most) return n + 1;
+        wk->bounce = first + n;
+        lobe = sample_bsdf(&cur->b, cur->wo, wk, &wi, &f_cos_pdf, &pdf);
+        if (lobe < 0) return n + 1;
+        cur->delta = lobe == MIRROR_LOBE || lobe == GLASS_LOBE;
+        if (cur->delta) pdf = 0;                /* no pdf: no other strategy finds it */
+        else prev->rev = to_area(bsdf_pdf(&cur->b, wi, cur->wo), cur->h.p, &prev->h);
+        beta = mul(beta, f_cos_pdf);
+        if (!survives(s, n, &beta, &f_cos_pdf, wk)) return n + 1;
+        wk->count.bounced++;
+        r = spawn(s, &cur->h, wi);
+    }
+    return n;
+}
+
+/* The light's subpath into p->y: y_0 on a light chosen by its power, as
+ * light tracing starts (emit_ray), and on from there; how many vertices
+ * (0: no light can send any). */
+static int light_subpath(const Scene *s, real time, Subpaths *p, Worker *wk)
+{
+    Ray r;
+    Start from;
+    vec beta;
+    real chance;
+    int l, escaped;
+    p->point = 0;
+    wk->bounce = LIGHT_PATH;
+    l = down_the_tree(s, v3(0, 0, 0), v3(0, 0, 0), 1, bounce_random(wk, LIGHT_CHOICE), &chance);
+    if (l < 0 || !emit_ray(s, l, time, wk, &r, &beta, &from)) return 0;
+    wk->count.bounced++;
+    p->point = s->lights.emit[l].type == POINT_LIGHT;
+    memset(&p->y[0], 0, sizeof p->y[0]);
+    p->y[0].h.p = r.o;
+    p->y[0].h.n = p->y[0].h.ng = from.n;
+    p->y[0].h.time = time;
+    p->y[0].h.obj = s->lights.emit[l].obj;
+    p->y[0].fwd = chance * from.pdf_point;
+    p->y[0].beta = scale(1 / p->y[0].fwd, from.emit);
+    return walk(s, r, scale(1 / chance, beta), from.pdf_dir, p->most_y, LIGHT_PATH, p->y, wk, &escaped);
+}
+
+/* A pdf per solid angle at the point `from` as a pdf per area at the hit
+ * `to`: times the cosine there over the squared distance. */
+static real to_area(real pdf, vec from, const Hit *to)
+{
+    vec d = sub(to->p, from);
+    real d2 = dot(d, d);
+    return d2 > 0 ? pdf * fabs(dot(to->ng, d)) / (d2 * sqrt(d2)) : 0;
+}
+
+/* The pdf per solid angle with which a camera sample sends its ray along
+ * d (see onto_film). */
+static real film_pdf(const Scene *s, vec d)
+{
+    real D = (real)s->set.w / 2 / s->cam.tan_half, cos_c = dot(d, s->cam.fwd);
+    return D * D / (cos_c * cos_c * cos_c * ((real)s->set.w * s->set.h));
+}
+
+/* Strategy s = 0: the camera's subpath meets a light at z_{t-1}: what it
+ * sends back along the subpath.  A glow no light path starts from (a
+ * cone's; a sphere's inside, unless inside_seen) has no other strategy:
+ * weight 1. */
+static vec met_light(const Scene *s, const Subpaths *p, int t)
+{
+    const Vertex *e = &p->z[t - 1];
+    const Material *m = &s->mat[e->h.mat];
+    int l = s->lights.emitter[e->h.obj], k;
+    Rev rev = { 0, 0, 0, 0 };
+    vec Le;
+    if (!(m->kl > 0) || !front_emits(s, e->h.obj, e->h.ng, e->wo)) return v3(0, 0, 0);
+    Le = scale(m->kl, mul(e->beta, m->color));
+    if (l < 0 || (kind(s, e->h.obj, &k) == SPHERE && dot(e->wo, e->h.ng) < 0 && !s->lights.emit[l].inward))
+        return Le;
+    rev.z1 = tree_chance(s, l, v3(0, 0, 0), v3(0, 0, 0), 1) / light_area(s, l);
+    if (t >= 3) rev.z2 = to_area(fabs(dot(e->h.ng, e->wo)) / (real)PI, e->h.p, &p->z[t - 2].h);
+    return scale(mis_weight(p, p->y, 0, t, rev, 0), Le);
+}
+
+/* Strategy s = 1: next-event estimation from z_{t-1}, its light chosen
+ * and sampled as sample_light's are (the tree's choice, not the sky),
+ * not as the light's subpath began.  Its weight takes the pdf of y_0 to be
+ * the subpath's all the same (choice by power, a point by area): the
+ * weights of a path's strategies then still add up to 1, which is all
+ * MIS needs to stay unbiased (Veach 1997, section 9.2), and they need no
+ * second light tree walk.  The inside of a sphere no light path leaves
+ * inward: s = 0's alone. */
+static vec to_light(const Scene *s, const Subpaths *p, int t, Worker *wk)
+{
+    const Vertex *v = &p->z[t - 1];
+    Vertex y0;
+    Rev rev;
+    vec wi, Le, f;
+    real dist, pdf, chance, cosi;
+    int l, point;
+    wk->bounce = t - 2;                         /* z_{t-1}'s block, as sample_light's */
+    l = down_the_tree(s, v->h.p, v->b.n, s->set.light_choice == BY_POWER,
+                      bounce_random(wk, LIGHT_CHOICE), &chance);
+    if (l < 0) return v3(0, 0, 0);
+    point = sample_emitter(s, l, v->h.p, v->b.n, v->h.time, bounce_random(wk, LIGHT_U),
+                           bounce_random(wk, LIGHT_V), &wi, &dist, &Le, &pdf);
+    cosi = dot(wi, v->b.n);
+    f = bsdf_eval(&v->b, v->wo, wi);
+    if (!(pdf > 0) || !(cosi > 0) || !nonzero(f)) return v3(0, 0, 0);
+    memset(&y0, 0, sizeof y0);
+    y0.h.p = comb(dist, wi, v->h.p);
+    y0.h.ng = point ? wi : light_normal(s, l, y0.h.p, v->h.time);
+    if (s->lights.emit[l].type == SPHERE_LIGHT && dot(y0.h.ng, wi) > 0 && !s->lights.emit[l].inward)
+        return v3(0, 0, 0);
+    if (!light_visible(s, &v->h, l, wi, dist, wk)) return v3(0, 0, 0);
+    y0.fwd = tree_chance(s, l, v3(0, 0, 0), v3(0, 0, 0), 1) / (point ? 1 : light_area(s, l));
+    rev.y1 = to_area(bsdf_pdf(&v->b, v->wo, wi), v->h.p, &y0.h);
+    rev.y2 = 0;
+    rev.z1 = to_area(point ? 1 / (4 * (real)PI) : fabs(dot(y0.h.ng, wi)) / (real)PI, y0.h.p, &v->h);
+    rev.z2 = t >= 3 ? to_area(bsdf_pdf(&v->b, wi, v->wo), v->h.p, &p->z[t - 2].h) : 0;
+    return scale(cosi / (pdf * chance) * mis_weight(p, &y0, 1, t, rev, point), mul(v->beta, mul(f, Le)));
+}
+
+/* The normal of light l at its point y, at the given time: a sphere's
+ * outward, a triangle's front. */
+static vec light_normal(const Scene *s, int l, vec y, real time)
+{
+    const Emitter *e = &s->lights.emit[l];
+    int k;
+    if (kind(s, e->obj, &k) == SPHERE)
+        return scale(1 / s->sph[k].rad, sub(rest_frame(s, e->obj, time, y), s->sph[k].cen));
+    return unit(cross(s->tri[k].e1, s->tri[k].e2));
+}
+
+/* Strategy t = 1: y_{s-1} joined to the eye, as light tracing does
+ * (to_camera), splatted where it lands.  With s = 1, y_0 itself, seen by
+ * the camera on its light: what it emits that way. */
+static void to_eye(const Scene *s, const Subpaths *p, int k, Worker *wk)
+{
+    const Vertex *v = &p->y[k - 1];
+    Rev rev = { 0, 0, 0, 0 };
+    vec wc, c;
+    real dist, x, y, pdf, cos_y;
+    if ((k == 1 && p->point) || !onto_film(s, v->h.p, &wc, &dist, &x, &y, &pdf)) return;
+    if (k == 1) {
+        cos_y = dot(v->h.n, wc);                /* the side the light path left by */
+        c = v->beta;
+    } else {
+        vec f = bsdf_eval(&v->b, v->wo, wc);
+        cos_y = nonzero(f) ? fabs(dot(v->b.n, wc)) : 0;
+        c = mul(v->beta, f);
+        rev.y2 = to_area(bsdf_pdf(&v->b, wc, v->wo), v->h.p, &p->y[k - 2].h);
+    }
+    if (!(cos_y > 0)) return;
+    rev.y1 = to_area(pdf, s->cam.eye, &v->h);
+    wk->count.shadow++;
+    if (!camera_sees(s, wc, dist, v->h.time, wk)) return;
+    splat(s, wk, x, y, scale(cos_y * pdf / (dist * dist) * mis_weight(p, p->y, k, 1, rev, p->point), c));
+}
+
+/* Strategy s, t >= 2: z_{t-1} and y_{s-1} joined by a line: f at each
+ * end, and the geometry term cos cos / dist^2 between them, if nothing
+ * lies between. */
+static vec join(const Scene *s, const Subpaths *p, int k, int t, Worker *wk)
+{
+    const Vertex *a = &p->z[t - 1], *b = &p->y[k - 1];
+    vec d = sub(b->h.p, a->h.p), wi, back, fa, fb;
+    real d2 = dot(d, d), dist = sqrt(d2);
+    Rev rev;
+    Ray r;
+    if (!(d2 > 0)) return v3(0, 0, 0);
+    wi = scale(1 / dist, d), back = scale(-1, wi);
+    fa = bsdf_eval(&a->b, a->wo, wi);
+    fb = bsdf_eval(&b->b, b->wo, back);
+    if (!nonzero(fa) || !nonzero(fb)) return v3(0, 0, 0);
+    r = spawn(s, &a->h, wi);
+    wk->count.shadow++;
+    if (any_hit(s, r, dist * (1 - 1024 * REAL_EPS) - 128 * REAL_EPS * b->h.error_scale, &wk->blocker[0], wk))
+        return v3(0, 0, 0);
+    rev = join_rev(p, k, t, wi);
+    return scale(dot(a->b.n, wi) * -dot(b->b.n, wi) / d2 * mis_weight(p, p->y, k, t, rev, p->point),
+                 mul(mul(a->beta, fa), mul(b->beta, fb)));
+}
+
+/* The pdfs a join of z_{t-1} and y_{s-1} along wi (from the one to the
+ * other) sets anew: each end's, and its neighbour's, as the other
+ * subpath, walking on through the join, would have made it. */
+static Rev join_rev(const Subpaths *p, int k, int t, vec wi)
+{
+    const Vertex *a = &p->z[t - 1], *b = &p->y[k - 1];
+    vec back = scale(-1, wi);
+    Rev rev;
+    rev.z1 = to_area(bsdf_pdf(&b->b, b->wo, back), b->h.p, &a->h);
+    rev.z2 = to_area(bsdf_pdf(&a->b, wi, a->wo), a->h.p, &p->z[t - 2].h);
+    rev.y1 = to_area(bsdf_pdf(&a->b, a->wo, wi), a->h.p, &b->h);
+    rev.y2 = to_area(bsdf_pdf(&b->b, back, b->wo), b->h.p, &p->y[k - 2].h);
+    return rev;
+}
+
+/* The power heuristic's weight of strategy (s, t) for the path it made
+ * (Veach 1997, section 10.2.1): 1 / sum over the strategies i that could
+ * have made it of (p_i / p_s)^2.  Each ratio p_i / p_s follows from the
+ * next one by one vertex changing sides, the pdf it has from the other
+ * side (rev) over its own (fwd), walking out from the join both ways.  A
+ * strategy is left out where it would join at a mirror or glass (a delta
+ * vertex), start from the eye at a point light, or need a subpath longer
+ * than it may be.  Roulette is left out of the pdfs: the weights still add
+ * up to 1.  The join's own ends and their neighbours take rev's pdfs; y is
+ * the light's subpath (for s = 1, the vertex to_light chose instead). */
+static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev, int point)
+{
+    real sum = 0, r = 1;
+    int i;
+    for (i = t - 1; i >= 1; i--) {              /* strategy (k + t - i, i): the eye's side shorter */
+        real rv = i == t - 1 ? rev.z1 : i == t - 2 ? rev.z2 : p->z[i].rev;
+        r *= nz(rv) / nz(p->z[i].fwd);
+        if ((i == t - 1 || !p->z[i].delta) && !p->z[i - 1].delta && (k + t - i <= p->most_y || k + t - i == 1))
+            sum += r * r;
+    }
+    r = 1;
+    for (i = k - 1; i >= 0; i--) {              /* strategy (i, k + t - i): the light's side shorter */
+        real rv = i == k - 1 ? rev.y1 : i == k - 2 ? rev.y2 : y[i].rev;
+        int before = i > 0 ? y[i - 1].delta : point;
+        r *= nz(rv) / nz(y[i].fwd);
+        if ((i == k - 1 || !y[i].delta) && !before && k + t - i <= p->most_z) sum += r * r;
+    }
+    return 1 / (1 + sum);
+}
+
+/* A pdf of 0 (a delta's) as 1 in mis_weight's ratios: it stands on both
+ * sides of a strategy's ratio and cancels. */
+static real nz(real pdf) { return pdf != 0 ? pdf : 1; }
 
 /* Russian roulette: from ROULETTE_FROM rays on, the path goes on with the
  * chance q that its throughput beta suggests (at most 0.95, so that a hall
@@ -2015,6 +2431,7 @@ static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, rea
     L->emit[L->nemit].obj = obj;
     L->emit[L->nemit].pos = pos;
     L->emit[L->nemit].intensity = intensity;
+    L->emit[L->nemit].inward = type == SPHERE_LIGHT && inside_seen(s, obj);
     if (obj >= 0) L->emitter[obj] = L->nemit;
     L->nemit++;
     if (type == SKY_LIGHT) return;
@@ -2036,6 +2453,17 @@ static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, rea
     leaf->power = power;
     leaf->child[0] = leaf->child[1] = -1;
     sphere_of_box(leaf);
+}
+
+/* Whether the inside of glowing sphere i can be seen: the eye is in it,
+ * or it is glass, or it moves (which this does not follow).  Only then do
+ * light paths leave it inward as well as outward (emit_ray); where nothing
+ * inside can be seen they would be wasted. */
+static int inside_seen(const Scene *s, int i)
+{
+    const Sphere *sp = &s->sph[i];
+    vec d = sub(s->cam.eye, sp->cen);
+    return dot(d, d) < sp->rad * sp->rad || s->mat[sp->mat].kt > 0 || moves(s, i);
 }
 
 /* The path tracer's lights, each with its power: point lights (intensity
@@ -2265,17 +2693,25 @@ static real importance(const LightNode *k, vec x, vec n)
 }
 
 /* The chance that choose_light picks light l at x, of normal n: the
- * same weights, from l's leaf up to the root. */
+ * sky's half, if there is a sky, and the tree's chance below. */
 static real light_choice(const Scene *s, int l, vec x, vec n)
 {
     const Lights *L = &s->lights;
     real chance = L->sky >= 0 && L->root >= 0 ? (real)0.5 : 1;
-    int k, up;
     if (l == L->sky) return chance;
+    return chance * tree_chance(s, l, x, n, s->set.light_choice == BY_POWER);
+}
+
+/* The chance that down_the_tree picks light l at x: the same weights,
+ * from l's leaf up to the root. */
+static real tree_chance(const Scene *s, int l, vec x, vec n, int by_power)
+{
+    const Lights *L = &s->lights;
+    real chance = 1;
+    int k, up;
     for (k = L->leaf[l]; (up = L->node[k].parent) >= 0; k = up) {
         const int *c = L->node[up].child;
-        real a = node_weight(s, c[0], x, n, s->set.light_choice == BY_POWER);
-        real b = node_weight(s, c[1], x, n, s->set.light_choice == BY_POWER);
+        real a = node_weight(s, c[0], x, n, by_power), b = node_weight(s, c[1], x, n, by_power);
         if (!(a + b > 0)) return 0;
         chance *= (k == c[0] ? a : b) / (a + b);
     }
@@ -3752,7 +4188,7 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
     int k;
     int rows = s->set.y1 - s->set.y0, done = 0, stride = row_stride(rows), nthreads = 1;
     int splats = (o->hooks && o->hooks->after_sample)
-                 || (s->set.integrator == PATH && s->set.estimator == LIGHT_TRACING);
+                 || (s->set.integrator == PATH && s->set.estimator >= LIGHT_TRACING);
     long long **splat = NULL;
     Tally *first;
     Image own, *into = img;
@@ -4161,6 +4597,7 @@ static void default_scene(Scene *s)
     s->shutter[1] = 1;                  /* open from time 0 to 1 */
     s->set.integrator = WHITTED;
     s->set.estimator = MIS;
+    s->set.strategy[0] = s->set.strategy[1] = -1;
     s->set.roulette = 1;
     s->lights.sky = -1;
     set_camera(s, v, why);
@@ -4332,16 +4769,22 @@ static void say_what_is_ignored(const Scene *s, const Args *a)
                 " numbers only for a lens, area lights, glossy rays and motion\n");
 }
 
-/* Light tracing splats into any pixel: it renders whole images, every
- * sample, and no pixel stops early; 0 with a message otherwise. */
+/* Light tracing and BDPT splat into any pixel: they render whole images,
+ * every sample, and no pixel stops early; and they join paths to a
+ * pinhole, not to a lens.  0 with a message otherwise. */
 static int light_tracing_can(const Scene *s, const Args *a, int all)
 {
+    const char *name = s->set.estimator == BDPT ? "bdpt" : "light";
     const char *why = s->set.adaptive > 0 ? "--adaptive"
                       : a->checkpoint > 0 || a->resume ? "--checkpoint and --resume"
                       : s->set.x0 || s->set.y0 || s->set.x1 < s->set.w || s->set.y1 < s->set.h
-                        || !all || strstr(a->output, ".part") ? "a split render" : NULL;
-    if (why) fprintf(stderr, "ray: --estimator light renders whole images only: not with %s\n", why);
-    if (!why && s->lights.sky >= 0)
+                        || !all || strstr(a->output, ".part") ? "a split render"
+                      : s->cam.lens > 0 ? "a lens (`lens`: the paths join a pinhole)" : NULL;
+    if (why) fprintf(stderr, "ray: --estimator %s renders whole images only: not with %s\n", name, why);
+    if (!why && s->lights.sky >= 0 && s->set.estimator == BDPT)
+        fprintf(stderr, "ray: warning: under --estimator bdpt only the camera's paths find the sky"
+                " (no light path starts from it): its light is BSDF-sampled alone\n");
+    else if (!why && s->lights.sky >= 0)
         fprintf(stderr, "ray: warning: under --estimator light the sky lights nothing (no light path"
                 " starts from it); it is seen only where the camera sees it\n");
     return !why;
@@ -4523,7 +4966,14 @@ int main(int argc, char **argv)
         free_scene(&s); free_args(&a);
         return 2;                   /* a part beyond the image: a usage error */
     }
-    if (ok && s.set.integrator == PATH && s.set.estimator == LIGHT_TRACING && !light_tracing_can(&s, &a, s.set.s0 == 0 && o.spp == spp)) {
+    if (ok && a.strategy[0] >= 0 && (s.set.integrator != PATH || s.set.estimator != BDPT)) {
+        fprintf(stderr, "ray: --strategy is bidirectional path tracing's: add --pt --estimator bdpt\n");
+        free_scene(&s); free_args(&a);
+        return 2;
+    }
+    if (a.strategy[0] >= 0) s.set.strategy[0] = a.strategy[0], s.set.strategy[1] = a.strategy[1];
+    if (ok && s.set.integrator == PATH && s.set.estimator >= LIGHT_TRACING
+        && !light_tracing_can(&s, &a, s.set.s0 == 0 && o.spp == spp)) {
         free_scene(&s); free_args(&a);
         return 2;
     }

@@ -14,47 +14,7 @@
 # instant against the lamp put there.  The same bytes on 1 and 3 threads;
 # split renders and --adaptive refused.
 . tests/lib.sh
-cat >"$TMP/points.sph" <<'SCENE'
-integrator path
-background 0 0 0
-camera 0 -8 3   0 0 1   0 0 1   50
-light -3 -2 5   2 2 2
-light 2.5 1 3   1.5 .8 .5
-tri -9 -9 0  9 -9 0  9 9 0     .8 .8 .8  .8 0 0 0 1
-tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
-0 0 1          .85 .35 .25   1      .8 0 0 0 1
-2 -1 .6        .3 .8 .4      .6     .7 0 0 0 1
-SCENE
-cat >"$TMP/twosided.sph" <<'SCENE'
-integrator path
-background 0 0 0
-camera 0 -8 3   0 0 1   0 0 1   50
-tri -9 -9 0  9 -9 0  9 9 0     .8 .8 .8  .8 0 0 0 1
-tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
-tri -2 1 1  2 1 1  0 1 4     1 .9 .7  0 0 0 3 1
-SCENE
-cat >"$TMP/seen.sph" <<'SCENE'
-integrator path
-background 0 0 0
-camera 0 -8 2   0 0 1.5   0 0 1   40
-0 3 2       1 .9 .7      1.2    0 0 0 4 1
--1.2 0 1.2  1 1 1        .9     0 0 1 0 1.5
-1.4 0 1.6   1 1 1        .8     0 .4 0 0 1
-tri -4 6 0  4 6 0  0 6 5     .5 .7 1  0 0 0 2 1
-0 -16 3     1 1 1        5      0 0 0 1 1
-SCENE
-blocks() {   # the worst block's z and the whole image's, of image $2 minus image $1 (w x h)
-  python3 -c "$PFM_PY
-a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
-w, h = int(sys.argv[3]), int(sys.argv[4])
-def z(ks):
-    d = [sum(b[3 * k:3 * k + 3]) - sum(a[3 * k:3 * k + 3]) for k in ks]
-    n = len(d); m = sum(d) / n; v = sum((x - m) ** 2 for x in d) / (n - 1)
-    return m / (v / n) ** 0.5 if v > 0 else (0 if m == 0 else 99)
-worst = max(abs(z([(y * h // 4 + j) * w + x * w // 4 + i for j in range(h // 4) for i in range(w // 4)]))
-            for y in range(4) for x in range(4))
-print('%.2f %.2f' % (worst, z(range(w * h))))" "$1" "$2" "$3" "$4"
-}
+. tests/estimators.sh
 for r in "cornell.sph -n 256" "lamp.sph -n 64 -d 2" "soft.sph --pt -n 128 -d 3" "points.sph -n 64 -d 3" \
          "twosided.sph -n 64 -d 3" "seen.sph -n 64 -d 6"; do
   set -- $r
@@ -69,19 +29,21 @@ for r in "cornell.sph -n 256" "lamp.sph -n 64 -d 2" "soft.sph --pt -n 128 -d 3" 
 done
 
 # a lamp that moves, seen at the shutter's one instant, is the lamp put there
-for at in moving placed; do
-  { echo "integrator path"; echo "camera 0 -8 3   0 0 1   0 0 1   50"
-    echo "tri -9 -9 0  9 -9 0  9 9 0     .8 .8 .8  .8 0 0 0 1"; echo "tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1"
-    echo "0 0 1   .85 .35 .25   1   .8 0 0 0 1"
-    if [ $at = moving ]; then echo "shutter 1 1"; echo "move 3 0 0"; echo "-1.5 1 2.5   1 .9 .7   .4   0 0 0 6 1"
-    else echo "1.5 1 2.5   1 .9 .7   .4   0 0 0 6 1"; fi; } >"$TMP/$at.sph"
-done
 ./ray "$TMP/placed.sph" -s 32x32 -n 64 -d 3 --seed 3 -o "$TMP/mis.pfm" 2>/dev/null
 ./ray "$TMP/moving.sph" -s 32x32 -n 64 -d 3 --seed 4 --estimator light -o "$TMP/light.pfm" 2>/dev/null
 read -r worst whole <<<"$(blocks "$TMP/mis.pfm" "$TMP/light.pfm" 32 32)"
 awk -v b="$worst" -v z="$whole" 'BEGIN { exit !(b != "" && b < 4.5 && z < 4 && z > -4) }' \
   && ok "a moving lamp at shutter 1 1, light traced, is MIS's lamp put there (worst of 16 blocks $worst standard errors, the whole image $whole)" \
   || bad "a moving lamp at shutter 1 1, light traced, differs from the lamp put there: worst block '$worst', whole image '$whole'"
+
+# the furnace, inside a glowing sphere of albedo .5 and Le 1.5: after 3
+# bounces L = Le (1 - a^4) / (1 - a) = 2.8125 (light paths leave the sphere
+# inward, since the eye is inside it)
+./ray "$TMP/furnace.sph" -s 32x32 -n 64 -d 4 --estimator light -o "$TMP/f.pfm" 2>/dev/null
+read -r mean z <<<"$(mean_z "$TMP/f.pfm" 2.8125)"
+awk -v z="$z" 'BEGIN { exit !(z != "" && z < 4 && z > -4) }' \
+  && ok "the furnace at -d 4: light tracing's mean $mean is 2.8125 within $z standard errors" \
+  || bad "the furnace at -d 4: light tracing's mean '$mean' is not 2.8125: '$z' standard errors"
 
 ./ray scenes/cornell.sph -s 40x30 -n 8 -t 1 --estimator light -o "$TMP/t1.pfm" 2>/dev/null
 ./ray scenes/cornell.sph -s 40x30 -n 8 -t 3 --estimator light -o "$TMP/t3.pfm" 2>/dev/null

@@ -30,6 +30,8 @@
 #     grid   the same for the grid
 #     whitted  tests/test_ray.c (Whitted's renderer: hits, shading, the skips)
 #     lighttrace  tests/lighttrace.test.sh (light tracing against MIS)
+#     bdpt   tests/bdpt.test.sh (tests/test_bdpt.c: the MIS weights; BDPT's
+#            images against MIS's and the furnace's)
 #     light  tests/light.test.sh (tests/test_light.c: Arvo's sampler and the
 #            light tree; the light choice's images)
 #
@@ -62,6 +64,7 @@ tests_of() {
     pt) echo "$build_pt; ./t >out 2>&1 || echo \"FAIL tests/test_pt.c exited \$?\" >>out; ! grep '^FAIL' out" ;;
     whitted) echo "$build_whitted; TMP=. ./t >out 2>&1 || echo \"FAIL tests/test_ray.c exited \$?\" >>out; ! grep '^FAIL' out" ;;
     lighttrace) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/lighttrace.test.sh >out 2>&1 || echo 'FAIL tests/lighttrace.test.sh exited' >>out; ! grep '^FAIL' out" ;;
+    bdpt) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/bdpt.test.sh >out 2>&1 || echo 'FAIL tests/bdpt.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     light) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/light.test.sh >out 2>&1 || echo 'FAIL tests/light.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     bvh|grid)
       local structs=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
@@ -86,6 +89,10 @@ probe_of() {
     lighttrace) echo "make -s ray >/dev/null 2>&1 || exit 3;
               for f in cornell lamp soft veach caustic; do
                 ./ray --pt -t 1 -s 24x16 -n 8 --estimator light -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f; cksum <p.pfm;
+              done" ;;
+    bdpt) echo "make -s ray >/dev/null 2>&1 || exit 3;
+              for f in cornell lamp soft glossy caustic; do
+                ./ray --pt -t 1 -s 24x16 -n 8 --estimator bdpt -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f; cksum <p.pfm;
               done" ;;
     light) echo "$build_light; make -s ray >/dev/null 2>&1 || exit 3; ./t . | sed 's/[0-9][0-9.]* s\\b//';
               for f in lights100 cornell veach lamp soft; do for c in importance power; do
