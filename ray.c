@@ -2004,7 +2004,12 @@ static int onto_film(const Scene *s, vec p, vec *wc, real *dist, real *x, real *
  * lamp seen through the glass ball by s = 0.  Those with t >= 2 belong to
  * the pixel the sample started in; those with t = 1 are splatted where
  * they land, as light tracing's are.  The sky is found only by the
- * camera's subpath (no light path starts from it), with weight 1. */
+ * camera's subpath (no light path starts from it), with weight 1.  One
+ * strategy is left out: (1, 1), a point of a light splatted where the eye
+ * sees it.  The camera's samples cover each pixel evenly (the R2 pattern),
+ * which no pdf shows: a light the eye sees then costs s = 0 almost no
+ * noise, and the splats would only add theirs (on the caustic's lamp, by
+ * their pdfs alone, they would take 99% of the weight). */
 #define HALF_PATH 256       /* vertices of one subpath at most: a path under roulette
                              * reaches it with odds below 0.95^250 */
 
@@ -2047,7 +2052,7 @@ static vec bdpt(const Scene *s, Ray r, Worker *wk)
     if (subpaths(s, r, &p, wk) && chosen(s, 0, p.nz + 1)) L = mul(p.z[p.nz].beta, s->background);
     for (t = 1; t <= p.nz; t++)
         for (k = 0; k <= (t == 1 || p.ny > 1 ? p.ny : 1) && k + t - 1 <= most; k++) {
-            if (k + t < 2 || !chosen(s, k, t)) continue;
+            if (k + t < 2 || (k == 1 && t == 1) || !chosen(s, k, t)) continue;
             if (t == 1) to_eye(s, &p, k, wk);
             else if (k == 0) L = add(L, met_light(s, &p, t));
             else if (k == 1) L = add(L, to_light(s, &p, t, wk));   /* needs no light subpath */
@@ -2084,7 +2089,16 @@ static int chosen(const Scene *s, int k, int t)
  * BSDF or roulette ends the walk, a ray leaves the scene (*escaped, with
  * v[n].beta what it carries) or there are most vertices.  Vertex n draws
  * from bounce block first + n: the camera's, the path tracer's blocks; a
- * light's, light tracing's.  Returns how many vertices there are. */
+ * light's, light tracing's.  Returns how many vertices there are.
+ *
+ * A mirror or glass has no pdf, only a delta, the same whichever way the
+ * path crosses it; what differs between strategies is how the directions
+ * it turns spread out over the surfaces beyond.  So its pdf is taken as
+ * the delta's unit mass per projected solid angle (Veach 1997, section
+ * 10.3.5), which per solid angle is the cosine there, and is turned into a
+ * pdf per area at the next vertex as any other: the weights then see that
+ * the caustic's light, spread thin from a small lamp and gathered by the
+ * ball, is found far better from the lamp than from the eye. */
 static int walk(const Scene *s, Ray r, vec beta, real pdf, int most, int first, Vertex *v, Worker *wk,
                 int *escaped)
 {
@@ -2106,8 +2120,9 @@ static int walk(const Scene *s, Ray r, vec beta, real pdf, int most, int first, 
         lobe = sample_bsdf(&cur->b, cur->wo, wk, &wi, &f_cos_pdf, &pdf);
         if (lobe < 0) return n + 1;
         cur->delta = lobe == MIRROR_LOBE || lobe == GLASS_LOBE;
-        if (cur->delta) pdf = 0;                /* no pdf: no other strategy finds it */
-        else prev->rev = to_area(bsdf_pdf(&cur->b, wi, cur->wo), cur->h.p, &prev->h);
+        if (cur->delta) pdf = fabs(dot(wi, cur->b.n));   /* see below */
+        prev->rev = to_area(cur->delta ? fabs(dot(cur->wo, cur->b.n)) : bsdf_pdf(&cur->b, wi, cur->wo),
+                            cur->h.p, &prev->h);
         beta = mul(beta, f_cos_pdf);
         if (!survives(s, n, &beta, &f_cos_pdf, wk)) return n + 1;
         wk->count.bounced++;
@@ -2229,30 +2244,24 @@ static vec light_normal(const Scene *s, int l, vec y, real time)
     return unit(cross(s->tri[k].e1, s->tri[k].e2));
 }
 
-/* Strategy t = 1: y_{s-1} joined to the eye, as light tracing does
- * (to_camera), splatted where it lands.  With s = 1, y_0 itself, seen by
- * the camera on its light: what it emits that way. */
+/* Strategy t = 1 (s >= 2): y_{s-1} joined to the eye, as light tracing
+ * does (to_camera), splatted where it lands. */
 static void to_eye(const Scene *s, const Subpaths *p, int k, Worker *wk)
 {
     const Vertex *v = &p->y[k - 1];
     Rev rev = { 0, 0, 0, 0 };
-    vec wc, c;
+    vec wc, f;
     real dist, x, y, pdf, cos_y;
-    if ((k == 1 && p->point) || !onto_film(s, v->h.p, &wc, &dist, &x, &y, &pdf)) return;
-    if (k == 1) {
-        cos_y = dot(v->h.n, wc);                /* the side the light path left by */
-        c = v->beta;
-    } else {
-        vec f = bsdf_eval(&v->b, v->wo, wc);
-        cos_y = nonzero(f) ? fabs(dot(v->b.n, wc)) : 0;
-        c = mul(v->beta, f);
-        rev.y2 = to_area(bsdf_pdf(&v->b, wc, v->wo), v->h.p, &p->y[k - 2].h);
-    }
-    if (!(cos_y > 0)) return;
+    if (!onto_film(s, v->h.p, &wc, &dist, &x, &y, &pdf)) return;
+    f = bsdf_eval(&v->b, v->wo, wc);
+    cos_y = fabs(dot(v->b.n, wc));
+    if (!nonzero(f) || !(cos_y > 0)) return;
     rev.y1 = to_area(pdf, s->cam.eye, &v->h);
+    rev.y2 = to_area(bsdf_pdf(&v->b, wc, v->wo), v->h.p, &p->y[k - 2].h);
     wk->count.shadow++;
     if (!camera_sees(s, wc, dist, v->h.time, wk)) return;
-    splat(s, wk, x, y, scale(cos_y * pdf / (dist * dist) * mis_weight(p, p->y, k, 1, rev, p->point), c));
+    splat(s, wk, x, y, scale(cos_y * pdf / (dist * dist) * mis_weight(p, p->y, k, 1, rev, p->point),
+                             mul(v->beta, f)));
 }
 
 /* Strategy s, t >= 2: z_{t-1} and y_{s-1} joined by a line: f at each
@@ -2308,6 +2317,7 @@ static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev
 {
     real sum = 0, r = 1;
     int i;
+    if (k + t == 2) return 1;                   /* a light the eye sees: s = 0's alone */
     for (i = t - 1; i >= 1; i--) {              /* strategy (k + t - i, i): the eye's side shorter */
         real rv = i == t - 1 ? rev.z1 : i == t - 2 ? rev.z2 : p->z[i].rev;
         r *= nz(rv) / nz(p->z[i].fwd);

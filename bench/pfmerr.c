@@ -2,9 +2,11 @@
  * bench: both are PFM files (linear radiance, as ./ray -o x.pfm writes).
  *
  *     cc -std=c99 -O2 -o pfmerr bench/pfmerr.c -lm
- *     ./pfmerr IMAGE.pfm REFERENCE.pfm
+ *     ./pfmerr IMAGE.pfm REFERENCE.pfm [NORMALS.pfm]
  *
- * Prints one line, "rmse=R lit_rmse=L display_rmse=D pixels=N":
+ * Prints one line, "rmse=R lit_rmse=L display_rmse=D pixels=N", and with
+ * NORMALS (./ray --view normal of the same scene and size) " floor_rmse=F
+ * floor_pixels=M" after it:
  *   rmse          root mean square difference of the linear values, every
  *                 pixel and channel: the bench's measure
  *   lit_rmse      the same over the pixels whose reference is below 1 in
@@ -13,6 +15,11 @@
  *                 the pixel (the same for every estimator) dominates
  *   display_rmse  of the images as shown: clamped to 0..1 and through the
  *                 sRGB curve, in 8-bit levels
+ *   floor_rmse    rmse over the pixels whose first hit faces straight up
+ *                 (y up: --view normal's 0.5 + n / 2 is (0.5, 1, 0.5)): the
+ *                 floor seen directly, where the caustic's light lands, and
+ *                 not the glass ball, whose images of the lamp only the
+ *                 camera's paths can find, whatever the estimator
  * Exit status 0, or 2 on an error (unreadable file, sizes differ).
  */
 #include <math.h>
@@ -63,25 +70,34 @@ static double shown(double v)
 
 int main(int argc, char **argv)
 {
-    pfm a, r;
-    double sum = 0, lit = 0, disp = 0;
-    long nlit = 0, k, n;
-    if (argc != 3) { fprintf(stderr, "usage: pfmerr IMAGE.pfm REFERENCE.pfm\n"); return 2; }
-    if (!load(argv[1], &a) || !load(argv[2], &r)) return 2;
-    if (a.w != r.w || a.h != r.h) { fprintf(stderr, "pfmerr: the sizes differ\n"); return 2; }
+    pfm a, r, nm;
+    double sum = 0, lit = 0, disp = 0, floor = 0;
+    long nlit = 0, nfloor = 0, k, n;
+    if (argc != 3 && argc != 4) { fprintf(stderr, "usage: pfmerr IMAGE.pfm REFERENCE.pfm [NORMALS.pfm]\n"); return 2; }
+    if (!load(argv[1], &a) || !load(argv[2], &r) || (argc == 4 && !load(argv[3], &nm))) return 2;
+    if (a.w != r.w || a.h != r.h || (argc == 4 && (nm.w != a.w || nm.h != a.h))) {
+        fprintf(stderr, "pfmerr: the sizes differ\n");
+        return 2;
+    }
     n = (long)a.w * a.h;
     for (k = 0; k < n; k++) {
         const float *p = a.px + 3 * k, *q = r.px + 3 * k;
         int c, bright = q[0] >= 1 || q[1] >= 1 || q[2] >= 1;
+        int up = argc == 4 && fabs(nm.px[3 * k] - 0.5) < 1e-4 && fabs(nm.px[3 * k + 1] - 1) < 1e-4
+                 && fabs(nm.px[3 * k + 2] - 0.5) < 1e-4;
         for (c = 0; c < 3; c++) {
             double d = (double)p[c] - q[c], e = shown(p[c]) - shown(q[c]);
             sum += d * d;
             disp += e * e;
             if (!bright) lit += d * d;
+            if (up) floor += d * d;
         }
         nlit += !bright;
+        nfloor += up;
     }
-    printf("rmse=%.6g lit_rmse=%.6g display_rmse=%.4g pixels=%ld\n", sqrt(sum / (3.0 * n)),
+    printf("rmse=%.6g lit_rmse=%.6g display_rmse=%.4g pixels=%ld", sqrt(sum / (3.0 * n)),
            nlit ? sqrt(lit / (3.0 * nlit)) : 0.0, sqrt(disp / (3.0 * n)), n);
+    if (argc == 4) printf(" floor_rmse=%.6g floor_pixels=%ld", nfloor ? sqrt(floor / (3.0 * nfloor)) : 0.0, nfloor);
+    printf("\n");
     return 0;
 }

@@ -23,6 +23,14 @@ static int near_enough(double a, double b) { return fabs(a - b) <= TOL * (fabs(a
 
 static vec towards(vec from, vec to) { return unit(sub(to, from)); }
 
+/* A pdf per solid angle at `from` as one per area at the hit `to`: the
+ * cosine there over the squared distance (here apart from ray.c's to_area). */
+static double per_area(double pdf, vec from, const Hit *to)
+{
+    vec d = sub(from, to->p);
+    return pdf * fabs(dot(unit(d), to->ng)) / dot(d, d);
+}
+
 /* The pdf per area at x[i] of the path x[0] (on the light) .. x[n] (the
  * eye), as the light's side makes it: the light's choice and point for
  * x[0], its emission for x[1], then each vertex's BSDF from the one before. */
@@ -31,9 +39,9 @@ static double from_light(const Scene *s, const Vertex *x, int i, int l, int poin
     if (i == 0) return tree_chance(s, l, v3(0, 0, 0), v3(0, 0, 0), 1) / (point ? 1 : light_area(s, l));
     if (i == 1) {
         real pdf = point ? 1 / (4 * (real)PI) : fabs(dot(x[0].h.ng, towards(x[0].h.p, x[1].h.p))) / (real)PI;
-        return to_area(pdf, x[0].h.p, &x[1].h);
+        return per_area(pdf, x[0].h.p, &x[1].h);
     }
-    return to_area(bsdf_pdf(&x[i - 1].b, towards(x[i - 1].h.p, x[i - 2].h.p), towards(x[i - 1].h.p, x[i].h.p)),
+    return per_area(bsdf_pdf(&x[i - 1].b, towards(x[i - 1].h.p, x[i - 2].h.p), towards(x[i - 1].h.p, x[i].h.p)),
                    x[i - 1].h.p, &x[i].h);
 }
 
@@ -41,8 +49,8 @@ static double from_light(const Scene *s, const Vertex *x, int i, int l, int poin
  * vertex's BSDF from the one after. */
 static double from_eye(const Scene *s, const Vertex *x, int i, int n)
 {
-    if (i == n - 1) return to_area(film_pdf(s, towards(x[n].h.p, x[i].h.p)), x[n].h.p, &x[i].h);
-    return to_area(bsdf_pdf(&x[i + 1].b, towards(x[i + 1].h.p, x[i + 2].h.p), towards(x[i + 1].h.p, x[i].h.p)),
+    if (i == n - 1) return per_area(film_pdf(s, towards(x[n].h.p, x[i].h.p)), x[n].h.p, &x[i].h);
+    return per_area(bsdf_pdf(&x[i + 1].b, towards(x[i + 1].h.p, x[i + 2].h.p), towards(x[i + 1].h.p, x[i].h.p)),
                    x[i + 1].h.p, &x[i].h);
 }
 
