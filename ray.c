@@ -574,7 +574,7 @@ static vec join(const Scene *s, const Subpaths *p, int k, int t, Worker *wk);
 typedef struct Rev Rev;
 static Rev join_rev(const Subpaths *p, int k, int t, vec wi);
 static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev, int point);
-static real nz(real pdf);
+static real over(real rev, real fwd);
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
@@ -2120,7 +2120,7 @@ static int walk(const Scene *s, Ray r, vec beta, real pdf, int most, int first, 
         lobe = sample_bsdf(&cur->b, cur->wo, wk, &wi, &f_cos_pdf, &pdf);
         if (lobe < 0) return n + 1;
         cur->delta = lobe == MIRROR_LOBE || lobe == GLASS_LOBE;
-        if (cur->delta) pdf = fabs(dot(wi, cur->b.n));   /* see below */
+        if (cur->delta) pdf = fabs(dot(wi, cur->b.n));   /* the delta's unit mass, as above */
         prev->rev = to_area(cur->delta ? fabs(dot(cur->wo, cur->b.n)) : bsdf_pdf(&cur->b, wi, cur->wo),
                             cur->h.p, &prev->h);
         beta = mul(beta, f_cos_pdf);
@@ -2320,23 +2320,24 @@ static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev
     if (k + t == 2) return 1;                   /* a light the eye sees: s = 0's alone */
     for (i = t - 1; i >= 1; i--) {              /* strategy (k + t - i, i): the eye's side shorter */
         real rv = i == t - 1 ? rev.z1 : i == t - 2 ? rev.z2 : p->z[i].rev;
-        r *= nz(rv) / nz(p->z[i].fwd);
-        if ((i == t - 1 || !p->z[i].delta) && !p->z[i - 1].delta && (k + t - i <= p->most_y || k + t - i == 1))
-            sum += r * r;
+        r *= over(rv, p->z[i].fwd);
+        if ((i == t - 1 || !p->z[i].delta) && !p->z[i - 1].delta && k + t - i <= p->most_y) sum += r * r;
     }
     r = 1;
     for (i = k - 1; i >= 0; i--) {              /* strategy (i, k + t - i): the light's side shorter */
         real rv = i == k - 1 ? rev.y1 : i == k - 2 ? rev.y2 : y[i].rev;
         int before = i > 0 ? y[i - 1].delta : point;
-        r *= nz(rv) / nz(y[i].fwd);
+        r *= over(rv, y[i].fwd);
         if ((i == k - 1 || !y[i].delta) && !before && k + t - i <= p->most_z) sum += r * r;
     }
     return 1 / (1 + sum);
 }
 
-/* A pdf of 0 (a delta's) as 1 in mis_weight's ratios: it stands on both
- * sides of a strategy's ratio and cancels. */
-static real nz(real pdf) { return pdf != 0 ? pdf : 1; }
+/* The ratio of a vertex's two pdfs, rev / fwd.  A rev of 0 (the other
+ * side could not have made the vertex) makes the strategies beyond it 0
+ * too, as they need it; fwd is never 0 for a vertex a walk made, but if
+ * it rounds to 0 the ratio is 0 rather than infinite. */
+static real over(real rev, real fwd) { return fwd > 0 ? rev / fwd : 0; }
 
 /* Russian roulette: from ROULETTE_FROM rays on, the path goes on with the
  * chance q that its throughput beta suggests (at most 0.95, so that a hall
