@@ -9,8 +9,8 @@
 # differences gives the error), and over the whole image within 4.  The
 # scenes: tests/estimators.sh's, the Cornell box, a room of GGX, Phong and
 # diffuse surfaces under a glowing sphere and a two-sided triangle
-# (room.sph), seen.sph over a floor, a room seen in a mirror (with a
-# glass ball's caustic on its floor), the 100 lamps of lights100.sph, a one-sided lamp close over a floor,
+# (room.sph), seen.sph over a floor, a floor and balls seen in a mirror
+# (and the mirror's caustic on the floor), the 100 lamps of lights100.sph, a one-sided lamp close over a floor,
 # a glowing sphere over a ball, the caustic, and a sky over a floor (the
 # sky found by the camera's paths alone).  The furnace's mean is exact
 # within 4 standard errors.  The images of every strategy (--strategy S,T)
@@ -27,8 +27,8 @@ tri -3 3 0  3 3 5  -3 3 5     1 1 1  0 .9 0 0 1
 tri -9 -12 0  9 -12 0  9 9 0     .8 .8 .8  .8 0 0 0 1
 tri -9 -12 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
 0 -9 1   .85 .35 .25   1   .8 0 0 0 1
--2 -8 .5   1 1 1   .5   0 0 1 0 1.5
-2 -9 4   1 .9 .7   .6   0 0 0 10 1
+-2 -8 .5   .4 .5 .9   .5   .8 0 0 0 1
+0 -5 9   1 .9 .7   .6   0 0 0 30 1
 SCENE
 cat >"$TMP/room.sph" <<'SCENE'
 integrator path
@@ -85,7 +85,7 @@ tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
 SCENE
 # scene, MIS's samples, BDPT's samples, options for both
 for r in "cornell.sph 256 64" "room.sph 256 64" "lamp.sph 64 16 -d 2" "soft.sph 128 32 --pt -d 3" "points.sph 64 16 -d 3" \
-         "twosided.sph 64 16 -d 3" "seen.sph 256 64 -d 6" "through.sph 256 64 -d 6" "caustic.sph 2048 256" "mirror.sph 256 64" "lights100.sph 64 16" "sky.sph 256 64 -d 3" \
+         "twosided.sph 64 16 -d 3" "seen.sph 256 64 -d 6" "through.sph 256 64 -d 6" "caustic.sph 2048 256" "mirror.sph 1024 256" "lights100.sph 64 16" "sky.sph 256 64 -d 3" \
          "moving.sph 64 16 -d 3"; do
   set -- $r
   f=$1 nm=$2 nb=$3; shift 3

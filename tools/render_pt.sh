@@ -15,3 +15,14 @@ done
 ./ray -s 256x256 -n 32 -o docs/pt/cornell-mis32.png scenes/cornell.sph
 ./ray -s 256x256 -n 32 --estimator light -o docs/pt/cornell-light.png scenes/cornell.sph
 ./ray -s 320x240 -n 64 --estimator light -o docs/pt/caustic-light.png scenes/caustic.sph
+# bidirectional path tracing beside MIS at about the same CPU time, and
+# strategies one by one (the README's "Bidirectional path tracing")
+./ray -s 320x240 -n 192 --stats -o docs/pt/caustic-mis-eq.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic mis: /'
+./ray -s 320x240 -n 64 --estimator bdpt --stats -o docs/pt/caustic-bdpt.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic bdpt: /'
+./ray -s 256x256 -n 8 --estimator bdpt --stats -o docs/pt/cornell-bdpt.png scenes/cornell.sph 2>&1 | grep '^time' | sed 's/^/cornell bdpt: /'
+for st in 0,3 1,2 2,1 0,4 1,3 2,2 3,1; do
+  ./ray -s 160x160 -n 64 --estimator bdpt --strategy $st -o "docs/pt/cornell-s${st/,/-}.png" scenes/cornell.sph
+done
+for st in 0,5 1,4 2,3 3,2 4,1; do
+  ./ray -s 160x120 -n 64 --estimator bdpt --strategy $st -o "docs/pt/caustic-s${st/,/-}.png" scenes/caustic.sph
+done
