@@ -2008,8 +2008,9 @@ static int onto_film(const Scene *s, vec p, vec *wc, real *dist, real *x, real *
  * strategy is left out: (1, 1), a point of a light splatted where the eye
  * sees it.  The camera's samples cover each pixel evenly (the R2 pattern),
  * which no pdf shows: a light the eye sees then costs s = 0 almost no
- * noise, and the splats would only add theirs (on the caustic's lamp, by
- * their pdfs alone, they would take 99% of the weight). */
+ * noise, and the splats would only add theirs (yet by their pdfs alone,
+ * on a lamp as small and far as the caustic's, they would take nearly all
+ * the weight). */
 #define HALF_PATH 256       /* vertices of one subpath at most: a path under roulette
                              * reaches it with odds below 0.95^250 */
 

@@ -18,7 +18,7 @@ done
 # bidirectional path tracing beside MIS at about the same CPU time, and
 # strategies one by one (the README's "Bidirectional path tracing")
 ./ray -s 320x240 -n 192 --stats -o docs/pt/caustic-mis-eq.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic mis: /'
-./ray -s 320x240 -n 64 --estimator bdpt --stats -o docs/pt/caustic-bdpt.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic bdpt: /'
+./ray -s 320x240 -n 112 --estimator bdpt --stats -o docs/pt/caustic-bdpt.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic bdpt: /'
 ./ray -s 256x256 -n 8 --estimator bdpt --stats -o docs/pt/cornell-bdpt.png scenes/cornell.sph 2>&1 | grep '^time' | sed 's/^/cornell bdpt: /'
 for st in 0,3 1,2 2,1 0,4 1,3 2,2 3,1; do
   ./ray -s 160x160 -n 64 --estimator bdpt --strategy $st -o "docs/pt/cornell-s${st/,/-}.png" scenes/cornell.sph
