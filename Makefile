@@ -28,11 +28,11 @@ PROGS = ray minray tools/ppmdiff tools/spd
 all: $(PROGS) ray.1
 
 # ray.c is the tracer; the files beside it read scenes (scene.c), write
-# images (image.c), read the command line (cli.c) and find hits (kdtree.c,
-# bvh.c, grid.c).  The tests and the fuzz targets include ray.c whole and
+# images (image.c), read the command line (cli.c), find hits (kdtree.c,
+# bvh.c, grid.c) and photons (photons.c).  The tests and the fuzz targets include ray.c whole and
 # link the rest: RAY_PARTS.
-RAY_PARTS = scene.c image.c cli.c kdtree.c bvh.c grid.c
-RAY_HEADERS = posix.h scene.h image.h cli.h kdtree.h bvh.h grid.h prims.h
+RAY_PARTS = scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c
+RAY_HEADERS = posix.h scene.h image.h cli.h kdtree.h bvh.h grid.h prims.h photons.h
 
 ray: ray.c $(RAY_PARTS) $(RAY_HEADERS)
 	$(CC) $(CFLAGS) $(FP) $(OMP) -o $@ ray.c $(RAY_PARTS) $(LDLIBS)

@@ -43,9 +43,12 @@ void usage(FILE *to)
           "  --estimator E  the path tracer's: bsdf (BSDF sampling only), nee (next-event\n"
           "             estimation), mis (both, by multiple importance sampling; default)\n"
           "             light (light tracing: paths from the lights, joined to the\n"
-          "             camera) or bdpt (bidirectional path tracing: a path from the\n"
+          "             camera), bdpt (bidirectional path tracing: a path from the\n"
           "             camera and one from a light, joined every way, weighed by MIS);\n"
-          "             light and bdpt: whole images only, no --adaptive, no lens\n"
+          "             or photon (photon mapping: caustic and global photon maps, a\n"
+          "             final gather); light and bdpt: whole images only, no --adaptive,\n"
+          "             no lens\n"
+          "  --photons N  photon mapping's photons (default 200000)\n"
           "  --strategy S,T  bdpt: only the paths made of S vertices from the light and\n"
           "             T from the camera, weighed as in the whole (S >= 0, T >= 1)\n"
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
@@ -265,10 +268,11 @@ static int estimator_arg(const char *v)
     if (!strcmp(v, "nee")) return 1;
     if (!strcmp(v, "light")) return 3;
     if (!strcmp(v, "bdpt")) return 4;
+    if (!strcmp(v, "photon")) return 5;
     if (strcmp(v, "mis")) {
         fprintf(stderr, "ray: --estimator takes bsdf (BSDF sampling only), nee (next-event"
-                " estimation), mis, light (light tracing) or bdpt (bidirectional path tracing),"
-                " not %s\n", v);
+                " estimation), mis, light (light tracing), bdpt (bidirectional path tracing) or"
+                " photon (photon mapping), not %s\n", v);
         exit(2);
     }
     return 2;
@@ -423,6 +427,7 @@ int parse_args(int argc, char **argv, Args *a)
         else if ((v = option_value(argc, argv, &i, "--sampler"))) a->sampler = sampler_arg(v);
         else if ((v = option_value(argc, argv, &i, "--light-choice"))) a->light_choice = light_choice_arg(v);
         else if ((v = option_value(argc, argv, &i, "--strategy"))) strategy_arg(a, v);
+        else if ((v = option_value(argc, argv, &i, "--photons"))) a->photons = int_arg("--photons", v, 1, 100000000);
         else if ((v = option_value(argc, argv, &i, "--crop"))) split_arg(a, "--crop", v);
         else if ((v = option_value(argc, argv, &i, "--tile"))) split_arg(a, "--tile", v);
         else if ((v = option_value(argc, argv, &i, "--samples"))) split_arg(a, "--samples", v);
@@ -468,7 +473,7 @@ static unsigned long long all_rays(const Stats *st)
 /* --stats=kv: for programs to read (bench/run.sh does). */
 static void print_stats_kv(FILE *f, const Stats *st)
 {
-    static const char *const estimators[] = { "bsdf", "nee", "mis", "light", "bdpt" };
+    static const char *const estimators[] = { "bsdf", "nee", "mis", "light", "bdpt", "photon" };
     fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
             st->spheres, st->cones, st->triangles, st->point_lights, st->glowing);
     fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", st->w, st->h, st->spp,
@@ -537,7 +542,8 @@ void print_stats(FILE *f, const Stats *st, int kv)
     static const char *const estimators[] = { "BSDF sampling only", "next-event estimation",
                                               "MIS (BSDF sampling and next-event estimation)",
                                               "light tracing (paths from the lights, to the camera)",
-                                              "bidirectional path tracing (MIS over every join)" };
+                                              "bidirectional path tracing (MIS over every join)",
+                                              "photon mapping (caustic and global maps, final gather)" };
     unsigned long long rays = all_rays(st);
     if (kv) {
         print_stats_kv(f, st);

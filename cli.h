@@ -29,6 +29,7 @@ typedef struct {
     int sampler;            /* --sampler: 0 independent, 1 sobol; -1: not given */
     int light_choice;       /* --light-choice: 0 importance, 1 power; -1: not given */
     int strategy[2];        /* --strategy S,T; -1: not given */
+    int photons;            /* --photons N; 0: not given */
     int roulette;           /* 0 after --no-roulette */
     int view;               /* --view; 0: the picture itself */
     double adaptive;        /* --adaptive E; 0: every pixel takes every sample */

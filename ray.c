@@ -1,7 +1,7 @@
 /* ray.c - the lecture "Ray Tracing + Global Illumination" as one C file:
  * Whitted's recursive ray tracer and Kajiya's path tracer side by side,
  * spheres, cones and triangles, and the structures that find hits (kdtree.c,
- * bvh.c, grid.c).  Everything a ray meets is here; reading scenes
+ * bvh.c, grid.c) and photons (photons.c).  Everything a ray meets is here; reading scenes
  * (scene.c), writing images (image.c) and the command line (cli.c, whose
  * `./ray --help` lists the options) live beside it.
  *
@@ -146,6 +146,7 @@
 #include "kdtree.h"
 #include "bvh.h"
 #include "grid.h"
+#include "photons.h"
 #include "scene.h"
 #include "image.h"
 #include "cli.h"
@@ -238,7 +239,7 @@ typedef struct {
     int depth;                /* Whitted: the recursion's depth */
     int max_rays;             /* path tracing: rays on a path at most (-d); 0: no bound but roulette */
     int spp;                  /* samples per pixel the scene asks for (0: none said) */
-    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS, LIGHT_TRACING or BDPT */
+    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT or PHOTON_MAPPING */
     int strategy[2];          /* --strategy S,T: BDPT's one strategy shown ({-1, -1}: all) */
     int roulette;             /* 1: Russian roulette ends paths */
     unsigned seed;            /* --seed: which noise */
@@ -248,6 +249,7 @@ typedef struct {
     int no_skip;              /* --no-skip: no work skipped that the plain algorithm does */
     int sampler;              /* the path tracer's numbers: INDEPENDENT or SOBOL (--sampler) */
     int light_choice;         /* how sample_light picks a light: BY_IMPORTANCE or BY_POWER */
+    int photons;              /* --photons N: photon mapping's photons */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
     int x0, y0, x1, y1;       /* the pixels rendered, x0 <= x < x1, y0 <= y < y1: the whole
                                * image, or a part of it (--crop, --tile) */
@@ -327,7 +329,7 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
  * only, by next-event estimation, or by both weighed by MIS. */
 enum { WHITTED, PATH };
 enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
-enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT };
+enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT, PHOTON_MAPPING };
 enum { INDEPENDENT, SOBOL };
 enum { BY_IMPORTANCE, BY_POWER };
 
@@ -549,7 +551,8 @@ static vec pixel_radiance(const Scene *s, int i, int j, int spp, Worker *wk);
 static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk);
 static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk);
 static int survives(const Scene *s, int rays, vec *beta, vec *f_cos_pdf, Worker *wk);
-static vec seen_directly(const Scene *s, Ray r, Worker *wk);
+typedef struct Photons Photons;
+static vec through_mirrors(const Scene *s, Ray r, const Photons *ph, Worker *wk);
 static void splat(const Scene *s, Worker *wk, real x, real y, vec L);
 static void trace_light_path(const Scene *s, int i, int j, int k, real time, Worker *wk);
 static int emit_ray(const Scene *s, int l, real time, Worker *wk, Ray *r, vec *beta, Start *from);
@@ -575,6 +578,17 @@ typedef struct Rev Rev;
 static Rev join_rev(const Subpaths *p, int k, int t, vec wi);
 static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev, int point);
 static real over(real rev, real fwd);
+typedef struct PhotonMap PhotonMap;
+static void shoot_photons(const Scene *s, void *data);
+static void shoot_photon(const Scene *s, Photons *ph, int i, Worker *wk);
+static void keep_photon(PhotonMap *m, vec p, vec power, vec from, int rays);
+static int smooth(const Bsdf *b);
+static vec direct_and_caustic(const Scene *s, const Hit *h, const Bsdf *b, vec wo, const Photons *ph,
+                              int most, Worker *wk);
+static vec gathered(const Scene *s, Ray r, const Photons *ph, int rays, Worker *wk);
+static vec photon_estimate(const Photons *ph, const PhotonMap *m, const Hit *h, const Bsdf *b, vec wo,
+                           int most);
+static void free_photons(Photons *ph);
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
@@ -1732,11 +1746,12 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
     r = primary_ray(s, i + dx, j + dy, wk);
     if (s->moving) r.time = shutter_time(s, k, st);
     if (s->set.estimator == LIGHT_TRACING) {     /* the camera's half, then one light path */
-        vec L = seen_directly(s, r, wk);
+        vec L = through_mirrors(s, r, NULL, wk);
         trace_light_path(s, i, j, k, r.time, wk);
         return L;
     }
     if (s->set.estimator == BDPT) return bdpt(s, r, wk);
+    if (s->set.estimator == PHOTON_MAPPING) return through_mirrors(s, r, wk->hooks->data, wk);
     return radiance(s, r, &path, wk);
 }
 
@@ -1782,7 +1797,7 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
  * splatted into the pixel the line crosses (to_camera).  A light path is
  * traced for every camera sample, from that sample's numbers, so the
  * bytes are the same on any number of threads.  The camera's own half
- * (seen_directly) counts only the lights it sees, directly or through
+ * (through_mirrors) counts only the lights it sees, directly or through
  * mirrors and glass, since no straight line from a light path reaches the
  * camera through them; what the camera sees of a diffuse surface through
  * glass (the floor through the ball) no path of either half finds, and is
@@ -1793,8 +1808,12 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
 #define LIGHT_PATH MAX_PATH             /* its numbers: the blocks after the camera path's */
 
 /* The camera's half: the lights seen from the camera directly, or through
- * a chain of mirrors and glass; the first other lobe ends it. */
-static vec seen_directly(const Scene *s, Ray r, Worker *wk)
+ * a chain of mirrors and glass; the first other lobe ends it.  With photon
+ * maps (ph; light tracing's camera half has none), photon mapping's camera
+ * half too: at each surface on the way that is not only a mirror or glass,
+ * the direct light and the caustics, and at the first lobe that is not a
+ * delta, the final gather (see photon mapping, below). */
+static vec through_mirrors(const Scene *s, Ray r, const Photons *ph, Worker *wk)
 {
     Path path;
     vec beta = v3(1, 1, 1), L = v3(0, 0, 0);
@@ -1812,7 +1831,10 @@ static vec seen_directly(const Scene *s, Ray r, Worker *wk)
         if (rays == most) return L;
         bsdf_at(s, &h, wo, &b);
         wk->bounce = rays - 1;
+        if (ph && smooth(&b)) L = add(L, mul(beta, direct_and_caustic(s, &h, &b, wo, ph, most - rays, wk)));
         lobe = sample_bsdf(&b, wo, wk, &wi, &f_cos_pdf, &pdf);
+        if (ph && lobe >= 0 && lobe != MIRROR_LOBE && lobe != GLASS_LOBE)
+            return add(L, mul(mul(beta, f_cos_pdf), gathered(s, spawn(s, &h, wi), ph, rays + 1, wk)));
         if (lobe != MIRROR_LOBE && lobe != GLASS_LOBE) return L;
         beta = mul(beta, f_cos_pdf);
         r = spawn(s, &h, wi);
@@ -2339,6 +2361,223 @@ static real mis_weight(const Subpaths *p, const Vertex *y, int k, int t, Rev rev
  * too, as they need it; fwd is never 0 for a vertex a walk made, but if
  * it rounds to 0 the ratio is 0 rather than infinite. */
 static real over(real rev, real fwd) { return fwd > 0 ? rev / fwd : 0; }
+
+/* ------------------------------------------------------------ photon mapping */
+
+/* Photon mapping (--estimator photon: Jensen, "Global illumination using
+ * photon maps", Eurographics Rendering Workshop 1996).  Two passes.
+ * First, before the pixels (render()'s pre-pass), --photons N photons
+ * leave the lights as light tracing's paths do, each with its share of
+ * their power, and bounce on by their BSDFs and roulette; where one lands
+ * on a surface that is not only a mirror or glass, it is kept: in the
+ * global map always, in the caustic map too when every bounce before was
+ * a mirror or glass (the light of a caustic).  Each map is a balanced
+ * kd-tree (photons.c).  Then each camera sample follows mirrors and glass
+ * to the first other surface x (through_mirrors, above), and there adds
+ *
+ *   - the direct light, by next-event estimation (sample_light);
+ *   - the caustics, from the caustic map: the k photons nearest x, each
+ *     photon's power times f, over the disc they fill (photon_estimate);
+ *   - the rest, by one final-gather ray from x's BSDF: where it meets the
+ *     next such surface (through mirrors and glass), the global map's
+ *     estimate there (gathered).
+ *
+ * The estimates from the maps are biased: they blur the light over the
+ * disc of the k nearest photons, which shrinks as the photons grow in
+ * number, so the bias falls with them (tests/photons.test.sh measures it).
+ * The sky lights only directly (no photon leaves it), and a final-gather
+ * ray meets only the smooth part of a surface that is also a mirror.  The
+ * photons are shot on one thread from their own numbers (a hash of the
+ * seed and the photon's number), so the maps, and the image, are the same
+ * on any number of threads; any split render of the image shoots the same
+ * photons.  Where things move, each photon leaves at its own instant of
+ * the shutter (its block's SPARE number), so the maps hold the light of
+ * the whole shutter, blurred. */
+#define PHOTON_K 64             /* photons an estimate takes */
+#define DEFAULT_PHOTONS 200000  /* --photons */
+
+/* A map: where each photon landed, the power it brings, the direction it
+ * came from, the rays it took from the light, and the tree over the
+ * points. */
+struct PhotonMap {
+    float (*at)[3];
+    vec *power, *from;
+    int *rays;
+    int n, cap;
+    PointTree tree;
+};
+
+/* Both maps, and the estimates' radius at most (squared): a tenth of the
+ * diagonal of the box the global map's photons fill. */
+struct Photons {
+    PhotonMap caustic, global;
+    real r2;
+};
+
+/* The pre-pass: every photon, then the trees. */
+static void shoot_photons(const Scene *s, void *data)
+{
+    Photons *ph = data;
+    Worker wk;
+    vec lo = v3(INFINITY, INFINITY, INFINITY), hi = scale(-1, lo), d;
+    int i;
+    memset(&wk, 0, sizeof wk);
+    for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
+    for (i = 0; i < s->set.photons; i++) shoot_photon(s, ph, i, &wk);
+    for (i = 0; i < ph->global.n; i++) {
+        vec p = v3(ph->global.at[i][0], ph->global.at[i][1], ph->global.at[i][2]);
+        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+    }
+    d = sub(hi, lo);
+    ph->r2 = ph->global.n ? dot(d, d) / 100 : 0;
+    if (!point_tree_build(&ph->caustic.tree, (const float (*)[3])ph->caustic.at, ph->caustic.n)
+        || !point_tree_build(&ph->global.tree, (const float (*)[3])ph->global.at, ph->global.n))
+        out_of_memory();
+}
+
+/* Photon i: from a light chosen by its power (emit_ray), its power the
+ * light's Le cos / pdf over the photons there are, on until its BSDF or
+ * roulette ends it.  Roulette follows the throughput since the light (a
+ * photon's power is small; its chance to go on must not be). */
+static void shoot_photon(const Scene *s, Photons *ph, int i, Worker *wk)
+{
+    Ray r;
+    Start from;
+    vec start, through = v3(1, 1, 1);
+    real chance, time;
+    int l, rays, caustic = 0, most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
+    wk->key = mix64(mix64(s->set.seed + 0x70686f746f6eULL) ^ (unsigned long long)i);
+    wk->sample = -1;
+    wk->bounce = LIGHT_PATH;
+    l = down_the_tree(s, v3(0, 0, 0), v3(0, 0, 0), 1, bounce_random(wk, LIGHT_CHOICE), &chance);
+    time = s->moving ? s->shutter[0] + (s->shutter[1] - s->shutter[0]) * bounce_random(wk, SPARE) : 0;
+    if (l < 0 || !emit_ray(s, l, time, wk, &r, &start, &from)) return;
+    start = scale(1 / (chance * s->set.photons), start);
+    for (rays = 1; rays < most; rays++) {
+        Hit h;
+        Bsdf b;
+        vec wi, f_cos_pdf, wl = scale(-1, r.d);
+        real pdf;
+        int lobe;
+        if (!nearest_hit(s, r, &h, wk)) return;
+        bsdf_at(s, &h, wl, &b);
+        if (smooth(&b)) {
+            keep_photon(&ph->global, h.p, mul(start, through), wl, rays);
+            if (caustic) keep_photon(&ph->caustic, h.p, mul(start, through), wl, rays);
+        }
+        wk->bounce = LIGHT_PATH + rays;
+        lobe = sample_bsdf(&b, wl, wk, &wi, &f_cos_pdf, &pdf);
+        if (lobe < 0) return;
+        caustic = (rays == 1 || caustic) && (lobe == MIRROR_LOBE || lobe == GLASS_LOBE);
+        through = mul(through, f_cos_pdf);
+        if (!survives(s, rays + 1, &through, &f_cos_pdf, wk)) return;
+        r = spawn(s, &h, wi);
+    }
+}
+
+/* One more photon in map m. */
+static void keep_photon(PhotonMap *m, vec p, vec power, vec from, int rays)
+{
+    if (m->n == m->cap) {           /* the same growth for the four arrays */
+        int a = m->cap, b = m->cap, c = m->cap, d = m->cap;
+        m->at = grow(m->at, &a, m->n + 1, sizeof *m->at);
+        m->power = grow(m->power, &b, m->n + 1, sizeof *m->power);
+        m->from = grow(m->from, &c, m->n + 1, sizeof *m->from);
+        m->rays = grow(m->rays, &d, m->n + 1, sizeof *m->rays);
+        m->cap = a;
+    }
+    m->rays[m->n] = rays;
+    m->at[m->n][0] = (float)p.x, m->at[m->n][1] = (float)p.y, m->at[m->n][2] = (float)p.z;
+    m->power[m->n] = power;
+    m->from[m->n++] = from;
+}
+
+/* Whether a BSDF has a part that is no delta (Lambert, Phong, GGX): what
+ * photons land on and estimates are made for. */
+static int smooth(const Bsdf *b)
+{
+    return b->p[DIFFUSE_LOBE] + b->p[GLOSSY_LOBE] + b->p[GGX_LOBE] > 0;
+}
+
+/* At a surface the camera's half of photon mapping meets, not only a
+ * mirror or glass: the direct light, by next-event estimation, and the
+ * caustics, from the caustic map's photons that took at most `most` rays. */
+static vec direct_and_caustic(const Scene *s, const Hit *h, const Bsdf *b, vec wo, const Photons *ph,
+                              int most, Worker *wk)
+{
+    return add(sample_light(s, h, b, wo, wk), photon_estimate(ph, &ph->caustic, h, b, wo, most));
+}
+
+/* A final-gather ray: through mirrors and glass to the next smooth
+ * surface, and the global map's estimate of what leaves it back along
+ * the ray (not its emission, nor the sky: the direct light is counted at
+ * the gathering point already). */
+static vec gathered(const Scene *s, Ray r, const Photons *ph, int rays, Worker *wk)
+{
+    vec beta = v3(1, 1, 1);
+    int most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
+    for (; rays <= most; rays++) {
+        Hit h;
+        Bsdf b;
+        vec wi, f_cos_pdf, wo = scale(-1, r.d);
+        real pdf;
+        if (!nearest_hit(s, r, &h, wk)) return v3(0, 0, 0);
+        bsdf_at(s, &h, wo, &b);
+        if (smooth(&b)) return mul(beta, photon_estimate(ph, &ph->global, &h, &b, wo, most - rays));
+        wk->bounce = rays - 1;
+        if (sample_bsdf(&b, wo, wk, &wi, &f_cos_pdf, &pdf) < 0) return v3(0, 0, 0);
+        beta = mul(beta, f_cos_pdf);
+        if (!survives(s, rays, &beta, &f_cos_pdf, wk)) return v3(0, 0, 0);
+        r = spawn(s, &h, wi);
+    }
+    return v3(0, 0, 0);
+}
+
+/* The radiance the photons of map m near h send towards wo: each of the
+ * PHOTON_K nearest (within the radius) its power times f, over the area
+ * pi r^2 of the disc they fill, r the farthest one's distance (Jensen
+ * 1996, eq. 6; the whole radius where fewer are found).  The farthest is
+ * left out of the sum: it lies on the disc's edge by its choice, and
+ * counting it too would make the estimate k / (k - 1) times too bright
+ * where the photons are uniform (the disc holds k - 1 on average).  Only
+ * the photons that took at most `most` rays count: the rays the camera's
+ * side has left under -d. */
+static vec photon_estimate(const Photons *ph, const PhotonMap *m, const Hit *h, const Bsdf *b, vec wo,
+                           int most)
+{
+    int idx[PHOTON_K], i, n;
+    float d2[PHOTON_K], x[3];
+    vec L = v3(0, 0, 0);
+    real r2;
+    if (!m->n) return L;
+    x[0] = (float)h->p.x, x[1] = (float)h->p.y, x[2] = (float)h->p.z;
+    n = point_tree_nearest(&m->tree, x, PHOTON_K, (float)ph->r2, idx, d2);
+    if (!n) return L;
+    if (n == PHOTON_K) r2 = d2[--n];
+    else r2 = ph->r2;
+    for (i = 0; i < n; i++) {
+        vec d = sub(v3(m->at[idx[i]][0], m->at[idx[i]][1], m->at[idx[i]][2]), h->p);
+        real off = dot(d, b->ng);
+        if (m->rays[idx[i]] <= most && off * off <= r2 / 100)    /* near h's own plane: see above */
+            L = add(L, mul(bsdf_eval(b, wo, m->from[idx[i]]), m->power[idx[i]]));
+    }
+    return scale(1 / ((real)PI * r2), L);
+}
+
+static void free_photons(Photons *ph)
+{
+    PhotonMap *m[2];
+    int i;
+    m[0] = &ph->caustic, m[1] = &ph->global;
+    for (i = 0; i < 2; i++) {
+        point_tree_free(&m[i]->tree);
+        free(m[i]->at);
+        free(m[i]->power);
+        free(m[i]->from);
+        free(m[i]->rays);
+    }
+}
 
 /* Russian roulette: from ROULETTE_FROM rays on, the path goes on with the
  * chance q that its throughput beta suggests (at most 0.95, so that a hall
@@ -4200,7 +4439,7 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
     int k;
     int rows = s->set.y1 - s->set.y0, done = 0, stride = row_stride(rows), nthreads = 1;
     int splats = (o->hooks && o->hooks->after_sample)
-                 || (s->set.integrator == PATH && s->set.estimator >= LIGHT_TRACING);
+                 || (s->set.integrator == PATH && (s->set.estimator == LIGHT_TRACING || s->set.estimator == BDPT));
     long long **splat = NULL;
     Tally *first;
     Image own, *into = img;
@@ -4939,6 +5178,8 @@ int main(int argc, char **argv)
     Partial part;
     const char *accel;
     char *checkpoint = NULL;
+    Photons photons;
+    Hooks photon_pass;
     int ok, sig, spp, as_part, done = parse_args(argc, argv, &a);
     double t0, load, build;
     clock_t c0;
@@ -4984,12 +5225,23 @@ int main(int argc, char **argv)
         return 2;
     }
     if (a.strategy[0] >= 0) s.set.strategy[0] = a.strategy[0], s.set.strategy[1] = a.strategy[1];
-    if (ok && s.set.integrator == PATH && s.set.estimator >= LIGHT_TRACING
+    if (ok && s.set.integrator == PATH && (s.set.estimator == LIGHT_TRACING || s.set.estimator == BDPT)
         && !light_tracing_can(&s, &a, s.set.s0 == 0 && o.spp == spp)) {
         free_scene(&s); free_args(&a);
         return 2;
     }
     if (ok) say_what_is_ignored(&s, &a);
+    s.set.photons = a.photons ? a.photons : DEFAULT_PHOTONS;
+    memset(&photons, 0, sizeof photons);
+    if (s.set.integrator == PATH && s.set.estimator == PHOTON_MAPPING) {     /* the photons: a pre-pass */
+        photon_pass.prepass = shoot_photons, photon_pass.after_sample = NULL, photon_pass.data = &photons;
+        o.hooks = &photon_pass;
+        if (s.lights.sky >= 0)
+            fprintf(stderr, "ray: warning: under --estimator photon the sky lights only directly (no photon"
+                    " leaves it)\n");
+    } else if (a.photons)
+        fprintf(stderr, "ray: warning: --photons is photon mapping's: it changes nothing without --estimator"
+                " photon\n");
     o.threads = a.threads;
     build = now();
     ok = ok && build_accel(&s, accel);
@@ -5045,6 +5297,7 @@ int main(int argc, char **argv)
                      (double)(clock() - c0) / CLOCKS_PER_SEC);
     if (!as_part) free_image(&img);
     if (o.part) free_partial(&part);
+    free_photons(&photons);
     free(o.done);
     free(checkpoint);
     free_args(&a);

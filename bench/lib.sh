@@ -30,7 +30,7 @@ build_time_tools() {
   local omp
   omp=$(echo 'int main(void){return 0;}' | $CC -fopenmp -x c - -o /dev/null 2>/dev/null && echo -fopenmp)
   # shellcheck disable=SC2086
-  $CC $CFLAGS $omp -o "$OUT/ray_pt" ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm &&
+  $CC $CFLAGS $omp -o "$OUT/ray_pt" ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c -lm &&
     $CC $CFLAGS -o "$OUT/pfmerr" bench/pfmerr.c -lm && $CC $CFLAGS -o "$OUT/svgplot" bench/svgplot.c -lm &&
     $CC $CFLAGS -o "$OUT/table" bench/table.c -lm
 }

@@ -5,8 +5,8 @@
 # For the Cornell box, smallpt's scene and the caustic: a reference
 # rendered at many samples (MIS, another seed, every core; kept in
 # bench/out between runs while ./ray and the scene are unchanged), then
-# each estimator (bsdf, nee, mis; and light tracing and BDPT on the Cornell
-# box and the caustic, see estimators_of) at 1, 4, 16, 64 and 256 samples per
+# each estimator (bsdf, nee, mis; and light tracing, BDPT and photon mapping
+# on the Cornell box and the caustic, see estimators_of) at 1, 4, 16, 64 and 256 samples per
 # pixel on one thread, each run's CPU time (user + system, of the whole
 # process) against its RMSE on linear values (bench/pfmerr.c).  The
 # estimators take turns (bsdf nee mis bsdf nee mis ...) in BENCH_PT_ROUNDS rounds at each sample count;
@@ -65,11 +65,12 @@ RAY=$OUT/ray_pt
 # tracing (--estimator light) too where the camera sees no diffuse
 # surface through glass or a mirror, which it cannot render (smallpt's
 # balls), or where it is the point (the caustic's floor; its ball, black
-# to light tracing, is then its error), and BDPT with it; at $TOP spp
-# (the caustic's alone), MIS and BDPT.
+# to light tracing, is then its error), and BDPT and photon mapping
+# (its 200,000 photons) with it; at $TOP spp (the caustic's alone), MIS
+# and BDPT.
 estimators_of() {
   if [ "$2" = "$TOP" ]; then echo mis bdpt; return; fi
-  case $1 in cornell|caustic) echo bsdf nee mis light bdpt ;; *) echo bsdf nee mis ;; esac
+  case $1 in cornell|caustic) echo bsdf nee mis light bdpt photon ;; *) echo bsdf nee mis ;; esac
 }
 
 # spps_of NAME: the sample counts a scene runs at.

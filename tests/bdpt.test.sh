@@ -85,7 +85,7 @@ tri -9 -9 0  9 9 0  -9 9 0     .8 .8 .8  .8 0 0 0 1
 SCENE
 # scene, MIS's samples, BDPT's samples, options for both
 for r in "cornell.sph 256 64" "room.sph 256 64" "lamp.sph 64 16 -d 2" "soft.sph 128 32 --pt -d 3" "points.sph 64 16 -d 3" \
-         "twosided.sph 64 16 -d 3" "seen.sph 256 64 -d 6" "through.sph 256 64 -d 6" "caustic.sph 2048 256" "mirror.sph 1024 256" "lights100.sph 64 16" "sky.sph 256 64 -d 3" \
+         "twosided.sph 64 16 -d 3" "seen.sph 256 64 -d 6" "through.sph 256 64 -d 6" "caustic.sph 1024 128" "mirror.sph 1024 256" "lights100.sph 64 16" "sky.sph 256 64 -d 3" \
          "moving.sph 64 16 -d 3"; do
   set -- $r
   f=$1 nm=$2 nb=$3; shift 3

@@ -10,7 +10,7 @@ CC=${CC:-cc}
 CFLAGS=${CFLAGS:--O2}
 # What a program that includes ray.c whole links beside it (the Makefile's
 # RAY_PARTS); word-split on purpose where it is used.
-RAY_PARTS=${RAY_PARTS:-scene.c image.c cli.c kdtree.c bvh.c grid.c}
+RAY_PARTS=${RAY_PARTS:-scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c}
 export TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
 # Python that reads a PFM's floats, for the tests' checkers: pfm(name) is

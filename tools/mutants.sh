@@ -32,6 +32,8 @@
 #     lighttrace  tests/lighttrace.test.sh (light tracing against MIS)
 #     bdpt   tests/bdpt.test.sh (tests/test_bdpt.c: the MIS weights; BDPT's
 #            images against MIS's and the furnace's)
+#     photon tests/photons.test.sh (tests/test_photons.c: the photon tree
+#            against brute force; photon mapping's bias)
 #     light  tests/light.test.sh (tests/test_light.c: Arvo's sampler and the
 #            light tree; the light choice's images)
 #
@@ -52,9 +54,9 @@ last=${3:-1000000}
 ref=$(mktemp -d "${TMPDIR:-/tmp}/mutants.XXXXXX") || exit 2
 trap 'rm -rf "$ref"' EXIT
 
-build_pt='cc -O2 -std=c99 -o t tests/test_pt.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || exit 3'
-build_whitted='cc -O2 -std=c99 -o t tests/test_ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || exit 3'
-build_light='cc -O2 -std=c99 -o t tests/test_light.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm || exit 3'
+build_pt='cc -O2 -std=c99 -o t tests/test_pt.c scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c -lm || exit 3'
+build_whitted='cc -O2 -std=c99 -o t tests/test_ray.c scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c -lm || exit 3'
+build_light='cc -O2 -std=c99 -o t tests/test_light.c scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c -lm || exit 3'
 build_accel='cc -O2 -o t tests/test_accel.c kdtree.c bvh.c grid.c -lm || exit 3; make -s ray tools/spd >/dev/null 2>&1 || exit 3'
 scenes='same mesh grid thirds tenths soup flat empty one'
 
@@ -65,6 +67,7 @@ tests_of() {
     whitted) echo "$build_whitted; TMP=. ./t >out 2>&1 || echo \"FAIL tests/test_ray.c exited \$?\" >>out; ! grep '^FAIL' out" ;;
     lighttrace) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/lighttrace.test.sh >out 2>&1 || echo 'FAIL tests/lighttrace.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     bdpt) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/bdpt.test.sh >out 2>&1 || echo 'FAIL tests/bdpt.test.sh exited' >>out; ! grep '^FAIL' out" ;;
+    photon) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/photons.test.sh >out 2>&1 || echo 'FAIL tests/photons.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     light) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/light.test.sh >out 2>&1 || echo 'FAIL tests/light.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     bvh|grid)
       local structs=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
@@ -93,6 +96,10 @@ probe_of() {
     bdpt) echo "make -s ray >/dev/null 2>&1 || exit 3;
               for f in cornell lamp soft glossy caustic; do
                 ./ray --pt -t 1 -s 24x16 -n 8 --estimator bdpt -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f; cksum <p.pfm;
+              done" ;;
+    photon) echo "make -s ray >/dev/null 2>&1 || exit 3;
+              for f in cornell soft caustic; do
+                ./ray --pt -t 1 -s 24x16 -n 4 --photons 20000 --estimator photon -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f; cksum <p.pfm;
               done" ;;
     light) echo "$build_light; make -s ray >/dev/null 2>&1 || exit 3; ./t . | sed 's/[0-9][0-9.]* s\\b//';
               for f in lights100 cornell veach lamp soft; do for c in importance power; do

@@ -10,7 +10,7 @@
 # an error (exit 2): a mutation that changes nothing proves nothing.
 #
 #   tools/mutate.sh ray.c 'cos_theta / (real)PI' 'cos_theta' -- \
-#       sh -c 'cc -O2 -o t tests/test_pt.c scene.c image.c cli.c kdtree.c bvh.c grid.c -lm && ./t'
+#       sh -c 'cc -O2 -o t tests/test_pt.c scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c -lm && ./t'
 #
 # The mutations run against tests/test_pt.c, and what they gave, are in
 # tools/mutations.txt.
