@@ -27,4 +27,4 @@ for st in 0,5 1,4 2,3 3,2 4,1; do
   ./ray -s 160x120 -n 64 --estimator bdpt --strategy $st -o "docs/pt/caustic-s${st/,/-}.png" scenes/caustic.sph
 done
 # photon mapping beside them (the README's "Photon mapping")
-./ray -s 320x240 -n 16 --estimator photon --stats -o docs/pt/caustic-photon.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic photon: /'
+./ray -s 320x240 -n 20 --estimator photon --stats -o docs/pt/caustic-photon.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic photon: /'
