@@ -44,11 +44,13 @@ void usage(FILE *to)
           "             estimation), mis (both, by multiple importance sampling; default)\n"
           "             light (light tracing: paths from the lights, joined to the\n"
           "             camera), bdpt (bidirectional path tracing: a path from the\n"
-          "             camera and one from a light, joined every way, weighed by MIS);\n"
-          "             or photon (photon mapping: caustic and global photon maps, a\n"
-          "             final gather); light and bdpt: whole images only, no --adaptive,\n"
-          "             no lens\n"
-          "  --photons N  photon mapping's photons (default 200000)\n"
+          "             camera and one from a light, joined every way, weighed by MIS),\n"
+          "             photon (photon mapping: caustic and global photon maps, a\n"
+          "             final gather), or ppm (progressive photon mapping: -n passes,\n"
+          "             each its own photons and a smaller radius); light and bdpt:\n"
+          "             whole images only, no --adaptive, no lens\n"
+          "  --photons N  photon mapping's photons (default 200000); ppm: each pass's\n"
+          "             (default: one per pixel)\n"
           "  --strategy S,T  bdpt: only the paths made of S vertices from the light and\n"
           "             T from the camera, weighed as in the whole (S >= 0, T >= 1)\n"
           "  --no-roulette  no Russian roulette: paths end at -d only\n"
@@ -87,7 +89,10 @@ void usage(FILE *to)
           "  --view V   instead of the picture, what a ray through each pixel's centre\n"
           "             meets: steps (the structure's work: nodes or cells plus tests,\n"
           "             black 0, blue 25, red 50, yellow 100, white 200), normal, depth;\n"
-          "             or samples: the samples each pixel took, white for all of -n\n"
+          "             or samples: the samples each pixel took, white for all of -n;\n"
+          "             or photons: the picture, and over it the photons stored (photon:\n"
+          "             the global map's blue, the caustic map's yellow; ppm: the last\n"
+          "             pass's)\n"
           "  --stats    print rays by kind, hits, the tree and time on stderr;\n"
           "             --stats=kv: the same as one `key value` line each\n"
           "  --version  the version, and how it was built\n"
@@ -147,8 +152,9 @@ static int view_arg(const char *v)
     if (!strcmp(v, "steps")) return 1;
     if (!strcmp(v, "normal")) return 2;
     if (!strcmp(v, "samples")) return 4;
+    if (!strcmp(v, "photons")) return 5;
     if (strcmp(v, "depth")) {
-        fprintf(stderr, "ray: --view takes steps, normal, depth or samples, not %s\n", v);
+        fprintf(stderr, "ray: --view takes steps, normal, depth, samples or photons, not %s\n", v);
         exit(2);
     }
     return 3;
@@ -269,10 +275,11 @@ static int estimator_arg(const char *v)
     if (!strcmp(v, "light")) return 3;
     if (!strcmp(v, "bdpt")) return 4;
     if (!strcmp(v, "photon")) return 5;
+    if (!strcmp(v, "ppm")) return 6;
     if (strcmp(v, "mis")) {
         fprintf(stderr, "ray: --estimator takes bsdf (BSDF sampling only), nee (next-event"
-                " estimation), mis, light (light tracing), bdpt (bidirectional path tracing) or"
-                " photon (photon mapping), not %s\n", v);
+                " estimation), mis, light (light tracing), bdpt (bidirectional path tracing),"
+                " photon (photon mapping) or ppm (progressive photon mapping), not %s\n", v);
         exit(2);
     }
     return 2;
@@ -473,7 +480,7 @@ static unsigned long long all_rays(const Stats *st)
 /* --stats=kv: for programs to read (bench/run.sh does). */
 static void print_stats_kv(FILE *f, const Stats *st)
 {
-    static const char *const estimators[] = { "bsdf", "nee", "mis", "light", "bdpt", "photon" };
+    static const char *const estimators[] = { "bsdf", "nee", "mis", "light", "bdpt", "photon", "ppm" };
     fprintf(f, "spheres %d\ncones %d\ntriangles %d\npoint_lights %d\nglowing_objects %d\n",
             st->spheres, st->cones, st->triangles, st->point_lights, st->glowing);
     fprintf(f, "width %d\nheight %d\nspp %d\nthreads %d\nrenderer %s\n", st->w, st->h, st->spp,
@@ -543,7 +550,8 @@ void print_stats(FILE *f, const Stats *st, int kv)
                                               "MIS (BSDF sampling and next-event estimation)",
                                               "light tracing (paths from the lights, to the camera)",
                                               "bidirectional path tracing (MIS over every join)",
-                                              "photon mapping (caustic and global maps, final gather)" };
+                                              "photon mapping (caustic and global maps, final gather)",
+                                              "progressive photon mapping (passes, the radius shrinking)" };
     unsigned long long rays = all_rays(st);
     if (kv) {
         print_stats_kv(f, st);

@@ -138,3 +138,36 @@ int point_tree_nearest(const PointTree *t, const float x[3], int k, float r2, in
     }
     return q.found;
 }
+
+/* The points of [lo, hi) within the radius of x, to visit. */
+static int within(const PointTree *t, const float x[3], float r2, int lo, int hi,
+                  void (*visit)(void *user, int i, float d2), void *user)
+{
+    int found = 0;
+    while (hi > lo) {
+        int m = (lo + hi) / 2, i = t->order[m], a = t->axis[m];
+        const float *p = t->p[i];
+        float d = x[a] - p[a], e0 = x[0] - p[0], e1 = x[1] - p[1], e2 = x[2] - p[2];
+        float dist = e0 * e0 + e1 * e1 + e2 * e2;
+        if (dist < r2) {
+            visit(user, i, dist);
+            found++;
+        }
+        if (d < 0) {                                /* the near side, the far side if in reach */
+            found += within(t, x, r2, lo, m, visit, user);
+            if (!(d * d < r2)) break;
+            lo = m + 1;
+        } else {
+            found += within(t, x, r2, m + 1, hi, visit, user);
+            if (!(d * d < r2)) break;
+            hi = m;
+        }
+    }
+    return found;
+}
+
+int point_tree_within(const PointTree *t, const float x[3], float r2,
+                      void (*visit)(void *user, int i, float d2), void *user)
+{
+    return within(t, x, r2, 0, t->n, visit, user);
+}

@@ -4,7 +4,8 @@
  * used for associative searching", CACM 1975).
  *
  * kdtree.c answers rays; this answers points: which k of the stored
- * points lie nearest a given point, within a given radius.  It knows the
+ * points lie nearest a given point, within a given radius, or which lie
+ * within the radius at all.  It knows the
  * points only as coordinates, numbered 0..n-1 in the caller's order; what
  * a photon carries stays with the caller (ray.c).
  *
@@ -33,6 +34,13 @@ int point_tree_build(PointTree *t, const float (*p)[3], int n);
  * numbers into idx and squared distances into d2, nearest first.  Returns
  * how many were found. */
 int point_tree_nearest(const PointTree *t, const float x[3], int k, float r2, int *idx, float *d2);
+
+/* Every point with squared distance below r2 from x: visit(user, i, d2)
+ * for each, in the tree's order (the same on every run).  Returns how
+ * many there were.  Progressive photon mapping's query: all photons in a
+ * disc of a given radius, however many. */
+int point_tree_within(const PointTree *t, const float x[3], float r2,
+                      void (*visit)(void *user, int i, float d2), void *user);
 
 void point_tree_free(PointTree *t);
 

@@ -239,17 +239,18 @@ typedef struct {
     int depth;                /* Whitted: the recursion's depth */
     int max_rays;             /* path tracing: rays on a path at most (-d); 0: no bound but roulette */
     int spp;                  /* samples per pixel the scene asks for (0: none said) */
-    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT or PHOTON_MAPPING */
+    int estimator;            /* the path tracer's: BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT, PHOTON_MAPPING
+                               * or PROGRESSIVE */
     int strategy[2];          /* --strategy S,T: BDPT's one strategy shown ({-1, -1}: all) */
     int roulette;             /* 1: Russian roulette ends paths */
     unsigned seed;            /* --seed: which noise */
-    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, or 0 */
+    int view;                 /* --view: VIEW_STEPS, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, VIEW_PHOTONS, or 0 */
     real adaptive;            /* --adaptive E: a pixel stops when its byte is known to E steps (0: off) */
     int srgb;                 /* the bytes go through the sRGB curve (for adaptive's rule) */
     int no_skip;              /* --no-skip: no work skipped that the plain algorithm does */
     int sampler;              /* the path tracer's numbers: INDEPENDENT or SOBOL (--sampler) */
     int light_choice;         /* how sample_light picks a light: BY_IMPORTANCE or BY_POWER */
-    int photons;              /* --photons N: photon mapping's photons */
+    int photons;              /* --photons N: photon mapping's photons (progressive: a pass's) */
     real far;                 /* --view depth: the farthest point of the scene from the eye */
     int x0, y0, x1, y1;       /* the pixels rendered, x0 <= x < x1, y0 <= y < y1: the whole
                                * image, or a part of it (--crop, --tile) */
@@ -328,8 +329,8 @@ enum { ACCEL_NONE, ACCEL_KD, ACCEL_BVH, ACCEL_GRID };
  * tracer's three estimators of the light at a point: by sampling the BSDF
  * only, by next-event estimation, or by both weighed by MIS. */
 enum { WHITTED, PATH };
-enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES };
-enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT, PHOTON_MAPPING };
+enum { VIEW_STEPS = 1, VIEW_NORMAL, VIEW_DEPTH, VIEW_SAMPLES, VIEW_PHOTONS };
+enum { BSDF_ONLY, NEE, MIS, LIGHT_TRACING, BDPT, PHOTON_MAPPING, PROGRESSIVE };
 enum { INDEPENDENT, SOBOL };
 enum { BY_IMPORTANCE, BY_POWER };
 
@@ -581,14 +582,21 @@ static real over(real rev, real fwd);
 typedef struct PhotonMap PhotonMap;
 static void shoot_photons(const Scene *s, void *data);
 static void shoot_photon(const Scene *s, Photons *ph, int i, Worker *wk);
+static void build_map(PhotonMap *m);
 static void keep_photon(PhotonMap *m, vec p, vec power, vec from, int rays);
 static int smooth(const Bsdf *b);
-static vec direct_and_caustic(const Scene *s, const Hit *h, const Bsdf *b, vec wo, const Photons *ph,
+static vec direct_and_photons(const Scene *s, const Hit *h, const Bsdf *b, vec wo, const Photons *ph,
                               int most, Worker *wk);
 static vec gathered(const Scene *s, Ray r, const Photons *ph, int rays, Worker *wk);
 static vec photon_estimate(const Photons *ph, const PhotonMap *m, const Hit *h, const Bsdf *b, vec wo,
                            int most);
+static int counts(const PhotonMap *m, int i, const Hit *h, const Bsdf *b, real r2, int most);
+static real pass_shrink(const Scene *s, Photons *ph);
+static real disc_radius2(const Photons *ph, const Hit *h);
+static vec disc_estimate(const Photons *ph, const Hit *h, const Bsdf *b, vec wo, int most);
+static void in_disc(void *user, int i, float d2);
 static void free_photons(Photons *ph);
+static void draw_photons(const Scene *s, const Photons *ph, Image *img);   /* --view photons, in the plumbing */
 static vec emitted(const Scene *s, const Hit *h, vec wo, const Path *path);
 static vec sky(const Scene *s, vec d, const Path *path);
 static real power_heuristic(real a, real b);
@@ -687,7 +695,7 @@ static void render_row(const Scene *s, int j, int spp, Image *img, Worker *wk)
 {
     int i;
     for (i = s->set.x0; i < s->set.x1; i++) {     /* the whole row, or a split render's part */
-        vec c = s->set.view && s->set.view != VIEW_SAMPLES ? pixel_view(s, i, j, wk)  /* --view: the plumbing */
+        vec c = s->set.view && s->set.view < VIEW_SAMPLES ? pixel_view(s, i, j, wk)  /* --view: the plumbing */
                 : s->set.integrator == PATH ? pixel_radiance(s, i, j, spp, wk)
                 : pixel_color(s, i, j, spp, wk);
         if (s->set.view == VIEW_SAMPLES) c = scale((real)wk->taken / spp, v3(1, 1, 1));
@@ -1751,7 +1759,8 @@ static vec sample_radiance(const Scene *s, int i, int j, int k, Worker *wk)
         return L;
     }
     if (s->set.estimator == BDPT) return bdpt(s, r, wk);
-    if (s->set.estimator == PHOTON_MAPPING) return through_mirrors(s, r, wk->hooks->data, wk);
+    if (s->set.estimator == PHOTON_MAPPING || s->set.estimator == PROGRESSIVE)
+        return through_mirrors(s, r, wk->hooks->data, wk);
     return radiance(s, r, &path, wk);
 }
 
@@ -1812,7 +1821,9 @@ static vec radiance(const Scene *s, Ray r, const Path *path, Worker *wk)
  * maps (ph; light tracing's camera half has none), photon mapping's camera
  * half too: at each surface on the way that is not only a mirror or glass,
  * the direct light and the caustics, and at the first lobe that is not a
- * delta, the final gather (see photon mapping, below). */
+ * delta, the final gather (see photon mapping, below); progressive photon
+ * mapping's has no final gather: its photons give all but the direct
+ * light. */
 static vec through_mirrors(const Scene *s, Ray r, const Photons *ph, Worker *wk)
 {
     Path path;
@@ -1831,7 +1842,7 @@ static vec through_mirrors(const Scene *s, Ray r, const Photons *ph, Worker *wk)
         if (rays == most) return L;
         bsdf_at(s, &h, wo, &b);
         wk->bounce = rays - 1;
-        if (ph && smooth(&b)) L = add(L, mul(beta, direct_and_caustic(s, &h, &b, wo, ph, most - rays, wk)));
+        if (ph && smooth(&b)) L = add(L, mul(beta, direct_and_photons(s, &h, &b, wo, ph, most - rays, wk)));
         lobe = sample_bsdf(&b, wo, wk, &wi, &f_cos_pdf, &pdf);
         if (ph && lobe >= 0 && lobe != MIRROR_LOBE && lobe != GLASS_LOBE)
             return add(L, mul(mul(beta, f_cos_pdf), gathered(s, spawn(s, &h, wi), ph, rays + 1, wk)));
@@ -2405,41 +2416,76 @@ struct PhotonMap {
     int *rays;
     int n, cap;
     PointTree tree;
+    real r2;                    /* a tenth of the diagonal of the photons' box, squared */
 };
 
 /* Both maps, and the estimates' radius at most (squared): a tenth of the
- * diagonal of the box the global map's photons fill. */
+ * diagonal of the box the first map's photons fill.  Progressive (see
+ * progressive photon mapping, below): the pass's photons in the global
+ * map, the pilot's in pilot, and the pass's radii over the first's,
+ * shrink, for pass `shrunk`.  key: the photons' numbers; into: the map
+ * the photons go to, when progressive. */
 struct Photons {
-    PhotonMap caustic, global;
+    PhotonMap caustic, global, pilot;
     real r2;
+    unsigned long long key;
+    int progressive;
+    PhotonMap *into;
+    real shrink;
+    int shrunk;
 };
 
-/* The pre-pass: every photon, then the trees. */
+/* The pre-pass: every photon, then the trees.  Progressive: every photon
+ * of the pass s->set.s0 (the last pass's gone), and the pilot's before
+ * the first pass. */
 static void shoot_photons(const Scene *s, void *data)
 {
     Photons *ph = data;
     Worker wk;
-    vec lo = v3(INFINITY, INFINITY, INFINITY), hi = scale(-1, lo), d;
     int i;
     memset(&wk, 0, sizeof wk);
     for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
+    ph->key = mix64(s->set.seed + 0x70686f746f6eULL);
+    if (ph->progressive && !ph->into) {         /* the pilot: photon mapping's numbers */
+        ph->into = &ph->pilot;
+        for (i = 0; i < s->set.photons; i++) shoot_photon(s, ph, i, &wk);
+        build_map(&ph->pilot);
+    }
+    if (ph->progressive) {
+        ph->key = mix64(ph->key + 1 + (unsigned)s->set.s0);
+        ph->into = &ph->global;
+        ph->global.n = 0;
+        point_tree_free(&ph->global.tree);
+        ph->shrink = pass_shrink(s, ph);
+    }
     for (i = 0; i < s->set.photons; i++) shoot_photon(s, ph, i, &wk);
-    for (i = 0; i < ph->global.n; i++) {
-        vec p = v3(ph->global.at[i][0], ph->global.at[i][1], ph->global.at[i][2]);
+    if (!ph->progressive) build_map(&ph->caustic);
+    build_map(&ph->global);
+    if (!ph->r2) ph->r2 = ph->progressive ? ph->pilot.r2 : ph->global.r2;
+}
+
+/* The tree over m's photons, and the radius bound of an estimate in it:
+ * a tenth of the diagonal of the photons' box. */
+static void build_map(PhotonMap *m)
+{
+    vec lo = v3(INFINITY, INFINITY, INFINITY), hi = scale(-1, lo), d;
+    int i;
+    for (i = 0; i < m->n; i++) {
+        vec p = v3(m->at[i][0], m->at[i][1], m->at[i][2]);
         lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
         hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
     }
     d = sub(hi, lo);
-    ph->r2 = ph->global.n ? dot(d, d) / 100 : 0;
-    if (!point_tree_build(&ph->caustic.tree, (const float (*)[3])ph->caustic.at, ph->caustic.n)
-        || !point_tree_build(&ph->global.tree, (const float (*)[3])ph->global.at, ph->global.n))
-        out_of_memory();
+    m->r2 = m->n ? dot(d, d) / 100 : 0;
+    if (!point_tree_build(&m->tree, (const float (*)[3])m->at, m->n)) out_of_memory();
 }
 
 /* Photon i: from a light chosen by its power (emit_ray), its power the
  * light's Le cos / pdf over the photons there are, on until its BSDF or
  * roulette ends it.  Roulette follows the throughput since the light (a
- * photon's power is small; its chance to go on must not be). */
+ * photon's power is small; its chance to go on must not be).  Progressive:
+ * kept only after a bounce (the direct light is next-event estimation's),
+ * in the pass's map or the pilot's. */
 static void shoot_photon(const Scene *s, Photons *ph, int i, Worker *wk)
 {
     Ray r;
@@ -2447,7 +2493,7 @@ static void shoot_photon(const Scene *s, Photons *ph, int i, Worker *wk)
     vec start, through = v3(1, 1, 1);
     real chance, time;
     int l, rays, caustic = 0, most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
-    wk->key = mix64(mix64(s->set.seed + 0x70686f746f6eULL) ^ (unsigned long long)i);
+    wk->key = mix64(ph->key ^ (unsigned long long)i);
     wk->sample = -1;
     wk->bounce = LIGHT_PATH;
     l = down_the_tree(s, v3(0, 0, 0), v3(0, 0, 0), 1, bounce_random(wk, LIGHT_CHOICE), &chance);
@@ -2462,7 +2508,8 @@ static void shoot_photon(const Scene *s, Photons *ph, int i, Worker *wk)
         int lobe;
         if (!nearest_hit(s, r, &h, wk)) return;
         bsdf_at(s, &h, wl, &b);
-        if (smooth(&b)) {
+        if (smooth(&b) && ph->progressive && rays > 1) keep_photon(ph->into, h.p, mul(start, through), wl, rays);
+        if (smooth(&b) && !ph->progressive) {
             keep_photon(&ph->global, h.p, mul(start, through), wl, rays);
             if (caustic) keep_photon(&ph->caustic, h.p, mul(start, through), wl, rays);
         }
@@ -2502,21 +2549,24 @@ static int smooth(const Bsdf *b)
 
 /* At a surface the camera's half of photon mapping meets, not only a
  * mirror or glass: the direct light, by next-event estimation, and the
- * caustics, from the caustic map's photons that took at most `most` rays. */
-static vec direct_and_caustic(const Scene *s, const Hit *h, const Bsdf *b, vec wo, const Photons *ph,
+ * caustics, from the caustic map's photons that took at most `most` rays;
+ * progressive: all the light but the direct, from the pass's photons. */
+static vec direct_and_photons(const Scene *s, const Hit *h, const Bsdf *b, vec wo, const Photons *ph,
                               int most, Worker *wk)
 {
-    return add(sample_light(s, h, b, wo, wk), photon_estimate(ph, &ph->caustic, h, b, wo, most));
+    return add(sample_light(s, h, b, wo, wk), ph->progressive ? disc_estimate(ph, h, b, wo, most)
+                                                              : photon_estimate(ph, &ph->caustic, h, b, wo, most));
 }
 
 /* A final-gather ray: through mirrors and glass to the next smooth
  * surface, and the global map's estimate of what leaves it back along
  * the ray (not its emission, nor the sky: the direct light is counted at
- * the gathering point already). */
+ * the gathering point already).  Progressive photon mapping has none. */
 static vec gathered(const Scene *s, Ray r, const Photons *ph, int rays, Worker *wk)
 {
     vec beta = v3(1, 1, 1);
     int most = s->set.max_rays ? s->set.max_rays : MAX_PATH;
+    if (ph->progressive) return v3(0, 0, 0);
     for (; rays <= most; rays++) {
         Hit h;
         Bsdf b;
@@ -2556,21 +2606,110 @@ static vec photon_estimate(const Photons *ph, const PhotonMap *m, const Hit *h, 
     if (!n) return L;
     if (n == PHOTON_K) r2 = d2[--n];
     else r2 = ph->r2;
-    for (i = 0; i < n; i++) {
-        vec d = sub(v3(m->at[idx[i]][0], m->at[idx[i]][1], m->at[idx[i]][2]), h->p);
-        real off = dot(d, b->ng);
-        if (m->rays[idx[i]] <= most && off * off <= r2 / 100)    /* near h's own plane: see above */
-            L = add(L, mul(bsdf_eval(b, wo, m->from[idx[i]]), m->power[idx[i]]));
-    }
+    for (i = 0; i < n; i++)
+        if (counts(m, idx[i], h, b, r2, most)) L = add(L, mul(bsdf_eval(b, wo, m->from[idx[i]]), m->power[idx[i]]));
     return scale(1 / ((real)PI * r2), L);
+}
+
+/* Whether photon i of map m counts in an estimate at h of radius sqrt(r2):
+ * it took at most `most` rays (what the camera's side has left under -d),
+ * and lies near h's own plane, within a tenth of the radius, so that a
+ * corner's estimate takes no photons of the wall across it. */
+static int counts(const PhotonMap *m, int i, const Hit *h, const Bsdf *b, real r2, int most)
+{
+    real off = dot(sub(v3(m->at[i][0], m->at[i][1], m->at[i][2]), h->p), b->ng);
+    return m->rays[i] <= most && off * off <= r2 / 100;
+}
+
+/* ------------------------------------------------ progressive photon mapping */
+
+/* Progressive photon mapping (--estimator ppm: Hachisuka, Ogaki and
+ * Jensen, "Progressive photon mapping", SIGGRAPH Asia 2008; stochastic:
+ * Hachisuka and Jensen 2009), in the form of Knaus and Zwicker,
+ * "Progressive photon mapping: a probabilistic approach", ACM TOG 2011.
+ * Photon mapping's estimate is biased by its radius r (it blurs the light
+ * over a disc) and noisy by the photons in the disc; with N photons the
+ * one falls as r^2 shrinks, the other as N r^2 grows.  So render in
+ * passes, each with photons of its own and one sample of every pixel,
+ * and shrink the radius a little each pass, slowly enough that the
+ * photons in the disc still grow over the passes:
+ *
+ *     r_{i+1}^2 = r_i^2 (i + alpha) / (i + 1),    alpha = 2/3
+ *
+ * Pass i's image is plain photon mapping with a fixed radius r_i (every
+ * photon within it, disc_estimate); the mean of the passes' images has
+ * the mean of their biases, which falls as r_i^2 does, about as
+ * i^(alpha - 1), and a variance that falls too, as i^(-alpha) (Knaus and
+ * Zwicker, section 4): the estimate converges.  Because the passes are
+ * independent, a pass is a sample like any other: the passes' sums add
+ * as a split render's do, on any number of threads or machines.
+ *
+ * The first radius is the point's own, as Jensen's k nearest are: that of
+ * the disc round it holding PPM_FIRST photons of a pilot map, shot once
+ * before the passes like a pass's (as many, photon mapping's numbers).
+ * So a caustic, where the photons crowd, starts sharp, and a dim wall
+ * smooth; the pilot is no pass's, so each pass's radius at a point is
+ * fixed before its photons come, as the argument above needs.  Per pass,
+ * the camera's side is photon mapping's without the final gather:
+ * mirrors and glass to the first other surface, the direct light there by
+ * next-event estimation, the rest from the pass's photons (those kept
+ * after a bounce). */
+#define PPM_ALPHA ((real)2 / 3)
+#define PPM_FIRST 16            /* pilot photons in the first disc */
+
+/* Pass k = s->set.s0's radii (squared) over the first pass's: the product
+ * of (i + alpha) / (i + 1) for i = 1..k, multiplied in that order whether
+ * the passes come in turn (one more factor each) or not, so that its bits
+ * are the same in any split of the passes. */
+static real pass_shrink(const Scene *s, Photons *ph)
+{
+    if (!ph->shrink || ph->shrunk > s->set.s0) ph->shrunk = 0, ph->shrink = 1;
+    for (; ph->shrunk < s->set.s0; ph->shrunk++) ph->shrink *= (ph->shrunk + 1 + PPM_ALPHA) / (ph->shrunk + 2);
+    return ph->shrink;
+}
+
+/* The pass's radius at h (squared): the first, the distance to the
+ * PPM_FIRST-th nearest pilot photon (the whole bound where there are
+ * fewer), times the pass's shrink. */
+static real disc_radius2(const Photons *ph, const Hit *h)
+{
+    int idx[PPM_FIRST], n;
+    float d2[PPM_FIRST], x[3];
+    x[0] = (float)h->p.x, x[1] = (float)h->p.y, x[2] = (float)h->p.z;
+    n = point_tree_nearest(&ph->pilot.tree, x, PPM_FIRST, (float)ph->r2, idx, d2);
+    return (n == PPM_FIRST ? d2[n - 1] : ph->r2) * ph->shrink;
+}
+
+/* Pass's estimate at h: every photon within its radius r, its power times
+ * f, over the disc's area pi r^2 (Hachisuka et al. 2008, eq. 6). */
+typedef struct { const PhotonMap *m; const Hit *h; const Bsdf *b; vec wo, L; real r2; int most; } Disc;
+
+static vec disc_estimate(const Photons *ph, const Hit *h, const Bsdf *b, vec wo, int most)
+{
+    Disc d;
+    float x[3];
+    if (!ph->global.n || !(ph->r2 > 0)) return v3(0, 0, 0);
+    d.m = &ph->global, d.h = h, d.b = b, d.wo = wo, d.L = v3(0, 0, 0), d.most = most;
+    d.r2 = disc_radius2(ph, h);
+    x[0] = (float)h->p.x, x[1] = (float)h->p.y, x[2] = (float)h->p.z;
+    point_tree_within(&ph->global.tree, x, (float)d.r2, in_disc, &d);
+    return scale(1 / ((real)PI * d.r2), d.L);
+}
+
+static void in_disc(void *user, int i, float d2)
+{
+    Disc *d = user;
+    (void)d2;
+    if (counts(d->m, i, d->h, d->b, d->r2, d->most))
+        d->L = add(d->L, mul(bsdf_eval(d->b, d->wo, d->m->from[i]), d->m->power[i]));
 }
 
 static void free_photons(Photons *ph)
 {
-    PhotonMap *m[2];
+    PhotonMap *m[3];
     int i;
-    m[0] = &ph->caustic, m[1] = &ph->global;
-    for (i = 0; i < 2; i++) {
+    m[0] = &ph->caustic, m[1] = &ph->global, m[2] = &ph->pilot;
+    for (i = 0; i < 3; i++) {
         point_tree_free(&m[i]->tree);
         free(m[i]->at);
         free(m[i]->power);
@@ -4404,7 +4543,7 @@ static Tally *first_samples(const Scene *s, const Options *o, int nthreads, Coun
     Tally *first;
     (void)nthreads;                     /* without OpenMP: one */
     if (!(s->set.adaptive > 0) || s->set.integrator != WHITTED || o->hooks || o->spp <= 4
-        || (s->set.view && s->set.view != VIEW_SAMPLES))
+        || (s->set.view && s->set.view < VIEW_SAMPLES))
         return NULL;
     if (!(first = malloc((size_t)s->set.w * s->set.h * sizeof *first))) out_of_memory();
     OMP(omp parallel num_threads(nthreads))
@@ -4507,6 +4646,40 @@ static void render(const Scene *s, const Options *o, Image *img, Counts *total)
         free_image(&own);
     }
     free(first);
+    if (o->progress) fprintf(stderr, "\r%30s\r", "");
+}
+
+/* Progressive photon mapping's render: pass after pass, each its own
+ * photons (the pre-pass, for the pass s->set.s0) and one sample of every
+ * pixel, into part's sums, which add the passes as ray --merge adds a
+ * split render's parts; so the bytes are those of any split of the
+ * passes by --samples.  The image, when there is one, from the sums. */
+static void image_of(const Partial *part, Image *img);
+
+static void render_passes(Scene *s, const Options *o, Partial *part, Image *img, Counts *total)
+{
+    Options one = *o;
+    Partial pass;
+    int first = s->set.s0, k;
+    size_t at, n = (size_t)(part->x1 - part->x0) * (part->y1 - part->y0);
+    pass = *part;
+    if (!new_partial(&pass)) out_of_memory();
+    one.spp = 1, one.progress = 0, one.part = &pass, one.done = NULL;
+    for (k = 0; k < o->spp && !stop_signal(); k++) {
+        s->set.s0 = first + k;
+        render(s, &one, NULL, total);
+        for (at = 0; at < n; at++) {
+            exact_sum(&part->sum[3 * at], &pass.sum[3 * at]);
+            exact_sum(&part->sum[3 * at + 1], &pass.sum[3 * at + 1]);
+            exact_sum(&part->sum[3 * at + 2], &pass.sum[3 * at + 2]);
+            part->n[at] += pass.n[at];
+        }
+        if (o->progress) show_progress(o->start, k + 1, o->spp);
+    }
+    s->set.s0 = first;
+    free_partial(&pass);
+    total->spp_min = total->spp_max = o->spp;
+    if (img) image_of(part, img);
     if (o->progress) fprintf(stderr, "\r%30s\r", "");
 }
 
@@ -4661,6 +4834,33 @@ static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
     if (!hit) return v3(0, 0, 0);
     if (s->set.view == VIEW_NORMAL) return scale((real)0.5, add(h.n, v3(1, 1, 1)));
     return v3(1 - h.t / s->set.far, 1 - h.t / s->set.far, 1 - h.t / s->set.far);
+}
+
+/* --view photons: the photons of the maps (progressive: of the last pass)
+ * over the picture, each a dot in the pixel it is seen in, where the eye
+ * sees it: the global map's blue, the caustic map's yellow over them. */
+static void draw_photons(const Scene *s, const Photons *ph, Image *img)
+{
+    static const double dot_of[2][3] = { { 0.2, 0.5, 1 }, { 1, 0.85, 0.2 } };
+    const PhotonMap *m[2];
+    Worker wk;
+    int k, i;
+    m[0] = &ph->global, m[1] = &ph->caustic;
+    memset(&wk, 0, sizeof wk);
+    for (i = 0; i < SHADOW_SLOTS; i++) wk.blocker[i] = -1;
+    for (k = 0; k < 2; k++)
+        for (i = 0; i < m[k]->n; i++) {
+            vec p = v3(m[k]->at[i][0], m[k]->at[i][1], m[k]->at[i][2]), wc;
+            real dist, x, y, pdf;
+            Ray r;
+            int last = -1;
+            if (!onto_film(s, p, &wc, &dist, &x, &y, &pdf)) continue;
+            if ((int)x < s->set.x0 || (int)x >= s->set.x1 || (int)y < s->set.y0 || (int)y >= s->set.y1) continue;
+            r.o = s->cam.eye, r.d = scale(-1, wc), r.tmin = 0, r.skip = -1, r.time = s->shutter[0];
+            if (any_hit(s, r, dist * (1 - (real)1e-4), &last, &wk)) continue;    /* hidden from the eye */
+            put_pixel(img, (int)x - s->set.x0, (int)y - s->set.y0,
+                      v3((real)dot_of[k][0], (real)dot_of[k][1], (real)dot_of[k][2]));
+        }
 }
 
 /* ------------------------------------------------------------- scene input */
@@ -5041,6 +5241,28 @@ static int light_tracing_can(const Scene *s, const Args *a, int all)
     return !why;
 }
 
+/* Photon mapping's choices: --photons and --view photons only with it,
+ * and progressive passes only whole (each a sample: no pixel stops early,
+ * and a checkpoint would hold half a pass); 0 with a message when they
+ * cannot work, a warning where the sky lights only directly. */
+static int photons_can(const Scene *s, const Args *a, int progressive)
+{
+    int mapped = s->set.integrator == PATH && (s->set.estimator == PHOTON_MAPPING || progressive);
+    const char *why = a->view == VIEW_PHOTONS && !mapped
+                      ? "--view photons draws photon mapping's photons: add --pt --estimator photon or ppm"
+                      : progressive && s->set.adaptive > 0 ? "--estimator ppm renders whole passes: not with --adaptive"
+                      : progressive && (a->checkpoint > 0 || a->resume)
+                        ? "--estimator ppm renders whole passes: not with --checkpoint or --resume" : NULL;
+    if (why) fprintf(stderr, "ray: %s\n", why);
+    if (!why && a->photons && !mapped)
+        fprintf(stderr, "ray: warning: --photons is photon mapping's: it changes nothing without --estimator"
+                " photon or ppm\n");
+    if (!why && mapped && s->lights.sky >= 0)
+        fprintf(stderr, "ray: warning: under --estimator %s the sky lights only directly (no photon leaves it)\n",
+                progressive ? "ppm" : "photon");
+    return !why;
+}
+
 /* The command line's choices for the path tracer (-1: not given) onto the
  * scene, and its lights; 0 with a message when they cannot work. */
 static int settle_path_options(Scene *s, int integrator, int estimator, int roulette, long seed)
@@ -5180,7 +5402,7 @@ int main(int argc, char **argv)
     char *checkpoint = NULL;
     Photons photons;
     Hooks photon_pass;
-    int ok, sig, spp, as_part, done = parse_args(argc, argv, &a);
+    int ok, sig, spp, as_part, progressive, done = parse_args(argc, argv, &a);
     double t0, load, build;
     clock_t c0;
 
@@ -5230,18 +5452,19 @@ int main(int argc, char **argv)
         free_scene(&s); free_args(&a);
         return 2;
     }
+    progressive = s.set.integrator == PATH && s.set.estimator == PROGRESSIVE;
+    if (ok && !photons_can(&s, &a, progressive)) {
+        free_scene(&s); free_args(&a);
+        return 2;
+    }
     if (ok) say_what_is_ignored(&s, &a);
-    s.set.photons = a.photons ? a.photons : DEFAULT_PHOTONS;
+    s.set.photons = a.photons ? a.photons : progressive ? s.set.w * s.set.h : DEFAULT_PHOTONS;
     memset(&photons, 0, sizeof photons);
-    if (s.set.integrator == PATH && s.set.estimator == PHOTON_MAPPING) {     /* the photons: a pre-pass */
+    photons.progressive = progressive;
+    if (s.set.integrator == PATH && (s.set.estimator == PHOTON_MAPPING || progressive)) {  /* a pre-pass */
         photon_pass.prepass = shoot_photons, photon_pass.after_sample = NULL, photon_pass.data = &photons;
         o.hooks = &photon_pass;
-        if (s.lights.sky >= 0)
-            fprintf(stderr, "ray: warning: under --estimator photon the sky lights only directly (no photon"
-                    " leaves it)\n");
-    } else if (a.photons)
-        fprintf(stderr, "ray: warning: --photons is photon mapping's: it changes nothing without --estimator"
-                " photon\n");
+    }
     o.threads = a.threads;
     build = now();
     ok = ok && build_accel(&s, accel);
@@ -5250,7 +5473,7 @@ int main(int argc, char **argv)
 
     if (a.view == VIEW_DEPTH) s.set.far = farthest(&s);
     as_part = out.format == FORMAT_PART;
-    if ((as_part || a.checkpoint > 0 || a.resume)
+    if ((as_part || a.checkpoint > 0 || a.resume || progressive)
         && (!start_partial(&s, &o, spp, &part) || !(o.done = calloc((size_t)(s.set.y1 - s.set.y0), 1))))
         out_of_memory();
     if (o.done) o.part = &part;
@@ -5279,7 +5502,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", s.set.integrator == PATH ? s.warning : s.whitted_warning);
     t0 = o.start = now();
     c0 = clock();
-    render(&s, &o, as_part ? NULL : &img, &st);
+    if (progressive) render_passes(&s, &o, &part, as_part ? NULL : &img, &st);
+    else render(&s, &o, as_part ? NULL : &img, &st);
     t0 = now() - t0;
     if ((sig = stop_signal())) {        /* the work so far saved, then end as the signal ends */
         if (save_partial(checkpoint, &part, o.done))
@@ -5289,7 +5513,8 @@ int main(int argc, char **argv)
         end_by_signal(sig);
         return 1;
     }
-    if (o.part && !as_part) image_of(&part, &img);     /* the rows resumed too */
+    if (o.part && !as_part && !progressive) image_of(&part, &img);     /* the rows resumed too */
+    if (a.view == VIEW_PHOTONS && !as_part) draw_photons(&s, &photons, &img);
     ok = as_part ? write_partial(&out, &part, NULL) : write_image(&out, &img, a.plain);
     if (ok && checkpoint) remove(checkpoint);      /* done: no checkpoint to go on from */
     if (a.stats)

@@ -63,3 +63,12 @@ a = pfm(sys.argv[1]); d = [sum(a[3 * k:3 * k + 3]) / 3 for k in range(len(a) // 
 n = len(d); m = sum(d) / n; v = sum((x - m) ** 2 for x in d) / (n - 1)
 print('%.4f %.2f' % (m, (m - float(sys.argv[2])) / (v / n) ** 0.5 if v > 0 else 99))" "$1" "$2"
 }
+
+threads_agree() {   # label, then ray's arguments: the same bytes on 1 and 3 threads (the first kept in $TMP/t1.pfm)
+  local label=$1
+  shift
+  ./ray "$@" -t 1 -o "$TMP/t1.pfm" 2>/dev/null
+  ./ray "$@" -t 3 -o "$TMP/t3.pfm" 2>/dev/null
+  [ -s "$TMP/t1.pfm" ] && cmp -s "$TMP/t1.pfm" "$TMP/t3.pfm" \
+    && ok "$label: the same bytes on 1 and 3 threads" || bad "$label: 1 and 3 threads differ"
+}

@@ -45,10 +45,7 @@ awk -v z="$z" 'BEGIN { exit !(z != "" && z < 4 && z > -4) }' \
   && ok "the furnace at -d 4: light tracing's mean $mean is 2.8125 within $z standard errors" \
   || bad "the furnace at -d 4: light tracing's mean '$mean' is not 2.8125: '$z' standard errors"
 
-./ray scenes/cornell.sph -s 40x30 -n 8 -t 1 --estimator light -o "$TMP/t1.pfm" 2>/dev/null
-./ray scenes/cornell.sph -s 40x30 -n 8 -t 3 --estimator light -o "$TMP/t3.pfm" 2>/dev/null
-[ -s "$TMP/t1.pfm" ] && cmp -s "$TMP/t1.pfm" "$TMP/t3.pfm" \
-  && ok "--estimator light: the same bytes on 1 and 3 threads" || bad "--estimator light: 1 and 3 threads differ"
+threads_agree "--estimator light" scenes/cornell.sph -s 40x30 -n 8 --estimator light
 
 for opt in "--adaptive 2" "--crop 0,0,8,8" "--samples 0:4" "-o $TMP/x.part"; do
   # shellcheck disable=SC2086

@@ -1,8 +1,9 @@
 /* photons.c's kd-tree against brute force: for random queries among
  * uniform, clustered, coplanar and repeated points, the k nearest within
  * a radius are the brute-force k nearest (their squared distances the
- * same, nearest first; which of two at the same distance may differ).
- * Fixed seeds. */
+ * same, nearest first; which of two at the same distance may differ),
+ * and the points within a radius are brute force's, each once.  Fixed
+ * seeds. */
 #include <stdio.h>
 #include <stdlib.h>
 #include "../photons.h"
@@ -12,6 +13,17 @@ static float rnd(unsigned long long *s)
 {
     *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
     return (float)((*s >> 40) / 16777216.0);
+}
+
+/* point_tree_within's visits: each point's count, and a wrong distance. */
+typedef struct { const float (*p)[3]; const float *x; int *seen, wrong; } Visits;
+
+static void visit(void *user, int i, float d2)
+{
+    Visits *v = user;
+    float e0 = v->x[0] - v->p[i][0], e1 = v->x[1] - v->p[i][1], e2 = v->x[2] - v->p[i][2];
+    v->seen[i]++;
+    v->wrong += d2 != e0 * e0 + e1 * e1 + e2 * e2;
 }
 
 static int cmp(const void *a, const void *b)
@@ -25,12 +37,12 @@ int main(void)
     static const char *const kinds[] = { "uniform", "clustered", "coplanar", "repeated" };
     enum { N = 20000, Q = 2000, K = 50 };
     static float p[N][3], all[N], d2[K];
-    static int idx[K];
+    static int idx[K], seen[N];
     unsigned long long s = 7;
     int kind;
     for (kind = 0; kind < 4; kind++) {
         PointTree t;
-        int i, q, bad = 0, total = 0, n = kind == 3 ? 2000 : N;
+        int i, q, bad = 0, total = 0, inside = 0, bad_within = 0, n = kind == 3 ? 2000 : N;
         char name[96];
         for (i = 0; i < n; i++) {
             float c = kind == 1 ? (float)(i % 7) : 0, r = kind == 1 ? 0.05f : 1;
@@ -47,6 +59,19 @@ int main(void)
                 float e0 = x[0] - p[i][0], e1 = x[1] - p[i][1], e2 = x[2] - p[i][2], d = e0 * e0 + e1 * e1 + e2 * e2;
                 if (d < r2) all[want++] = d;
             }
+            if (r2 < 1) {                       /* every point within the radius, once */
+                Visits v;
+                int got;
+                v.p = (const float (*)[3])p, v.x = x, v.seen = seen, v.wrong = 0;
+                for (i = 0; i < n; i++) seen[i] = 0;
+                got = point_tree_within(&t, x, r2, visit, &v);
+                for (i = 0; i < n; i++) {
+                    float e0 = x[0] - p[i][0], e1 = x[1] - p[i][1], e2 = x[2] - p[i][2];
+                    v.wrong += seen[i] != (e0 * e0 + e1 * e1 + e2 * e2 < r2);
+                }
+                inside += got;
+                bad_within += v.wrong || got != want;
+            }
             qsort(all, (size_t)want, sizeof *all, cmp);
             if (want > k) want = k;
             total += found;
@@ -58,6 +83,9 @@ int main(void)
         }
         sprintf(name, "the photon tree's k nearest, %s points, are brute force's", kinds[kind]);
         report(bad == 0, name, "%d queries of 1 to %d within a radius, %d points found, %d differ", Q, K, total, bad);
+        sprintf(name, "the photon tree's points within a radius, %s points, are brute force's", kinds[kind]);
+        report(bad_within == 0 && inside > 0, name, "%d queries, %d points found, %d differ", Q - Q / 3, inside,
+               bad_within);
         point_tree_free(&t);
     }
     return failures != 0;
