@@ -33,7 +33,8 @@
 #     bdpt   tests/bdpt.test.sh (tests/test_bdpt.c: the MIS weights; BDPT's
 #            images against MIS's and the furnace's)
 #     photon tests/photons.test.sh (tests/test_photons.c: the photon tree
-#            against brute force; photon mapping's bias)
+#            against brute force; photon mapping's bias, progressive photon
+#            mapping's, --view photons)
 #     light  tests/light.test.sh (tests/test_light.c: Arvo's sampler and the
 #            light tree; the light choice's images)
 #
@@ -100,6 +101,8 @@ probe_of() {
     photon) echo "make -s ray >/dev/null 2>&1 || exit 3;
               for f in cornell soft caustic; do
                 ./ray --pt -t 1 -s 24x16 -n 4 --photons 20000 --estimator photon -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f; cksum <p.pfm;
+                ./ray --pt -t 1 -s 24x16 -n 8 --estimator ppm -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f ppm; cksum <p.pfm;
+                ./ray --pt -t 1 -s 24x16 -n 1 --photons 5000 --estimator photon --view photons -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f dots; cksum <p.pfm;
               done" ;;
     light) echo "$build_light; make -s ray >/dev/null 2>&1 || exit 3; ./t . | sed 's/[0-9][0-9.]* s\\b//';
               for f in lights100 cornell veach lamp soft; do for c in importance power; do
