@@ -4838,7 +4838,9 @@ static vec pixel_view(const Scene *s, int i, int j, Worker *wk)
 
 /* --view photons: the photons of the maps (progressive: of the last pass)
  * over the picture, each a dot in the pixel it is seen in, where the eye
- * sees it: the global map's blue, the caustic map's yellow over them. */
+ * sees it: the global map's blue, the caustic map's yellow over them.
+ * Seen: the eye's ray towards it first meets a surface there (within a
+ * thousandth of the way), on the side the photon came from. */
 static void draw_photons(const Scene *s, const Photons *ph, Image *img)
 {
     static const double dot_of[2][3] = { { 0.2, 0.5, 1 }, { 1, 0.85, 0.2 } };
@@ -4853,11 +4855,13 @@ static void draw_photons(const Scene *s, const Photons *ph, Image *img)
             vec p = v3(m[k]->at[i][0], m[k]->at[i][1], m[k]->at[i][2]), wc;
             real dist, x, y, pdf;
             Ray r;
-            int last = -1;
+            Hit h;
             if (!onto_film(s, p, &wc, &dist, &x, &y, &pdf)) continue;
             if ((int)x < s->set.x0 || (int)x >= s->set.x1 || (int)y < s->set.y0 || (int)y >= s->set.y1) continue;
             r.o = s->cam.eye, r.d = scale(-1, wc), r.tmin = 0, r.skip = -1, r.time = s->shutter[0];
-            if (any_hit(s, r, dist * (1 - (real)1e-4), &last, &wk)) continue;    /* hidden from the eye */
+            if (!nearest_hit(s, r, &h, &wk) || fabs(h.t - dist) > dist / 1000
+                || dot(m[k]->from[i], h.ng) * dot(wc, h.ng) <= 0)
+                continue;                                           /* hidden from the eye */
             put_pixel(img, (int)x - s->set.x0, (int)y - s->set.y0,
                       v3((real)dot_of[k][0], (real)dot_of[k][1], (real)dot_of[k][2]));
         }
@@ -5478,7 +5482,7 @@ int main(int argc, char **argv)
         out_of_memory();
     if (o.done) o.part = &part;
     if (!as_part && !new_image(&img, s.set.x1 - s.set.x0, s.set.y1 - s.set.y0, float_format(out.format),
-                               !a.view && (s.set.integrator == PATH || a.gamma))) {
+                               (!a.view || a.view == VIEW_PHOTONS) && (s.set.integrator == PATH || a.gamma))) {
         fprintf(stderr, "ray: out of memory for a %dx%d image\n", s.set.w, s.set.h);
         discard_output(&out);
         free_scene(&s); free_args(&a);

@@ -5,8 +5,9 @@
 # For the Cornell box, smallpt's scene and the caustic: a reference
 # rendered at many samples (MIS, another seed, every core; kept in
 # bench/out between runs while ./ray and the scene are unchanged), then
-# each estimator (bsdf, nee, mis; and light tracing, BDPT and photon mapping
-# on the Cornell box and the caustic, see estimators_of) at 1, 4, 16, 64 and 256 samples per
+# each estimator (bsdf, nee, mis; and light tracing, BDPT, photon mapping
+# and progressive photon mapping on the Cornell box and the caustic, see
+# estimators_of) at 1, 4, 16, 64 and 256 samples per
 # pixel on one thread, each run's CPU time (user + system, of the whole
 # process) against its RMSE on linear values (bench/pfmerr.c).  The
 # estimators take turns (bsdf nee mis bsdf nee mis ...) in BENCH_PT_ROUNDS rounds at each sample count;
@@ -27,8 +28,9 @@
 #     BENCH_SMALLPT=path/to/smallpt.cpp (the 99-line original) to run it;
 #   - rays per second of the path tracer (MIS) within 10% of the Whitted
 #     renderer's on the same scene (smallpt's), one thread;
-#   - the caustic: BDPT reaches the RMSE of MIS at 1024 spp in at most 1/10
-#     of its time (MIS and BDPT also run at 1024 spp there, taking turns),
+#   - the caustic: BDPT or progressive photon mapping reaches the RMSE of
+#     MIS at 1024 spp in at most 1/10 of its time (MIS and BDPT also run at
+#     1024 spp there, taking turns; each method's figure is printed),
 #     over the whole image and over the floor seen directly (floor_rmse of
 #     bench/pfmerr.c: where the caustic lands, not the glass ball, whose
 #     images of the lamp only the camera's paths find, for every estimator).
@@ -66,11 +68,11 @@ RAY=$OUT/ray_pt
 # surface through glass or a mirror, which it cannot render (smallpt's
 # balls), or where it is the point (the caustic's floor; its ball, black
 # to light tracing, is then its error), and BDPT and photon mapping
-# (its 200,000 photons) with it; at $TOP spp (the caustic's alone), MIS
-# and BDPT.
+# (its 200,000 photons) and progressive photon mapping (its passes: the
+# samples) with it; at $TOP spp (the caustic's alone), MIS and BDPT.
 estimators_of() {
   if [ "$2" = "$TOP" ]; then echo mis bdpt; return; fi
-  case $1 in cornell|caustic) echo bsdf nee mis light bdpt photon ;; *) echo bsdf nee mis ;; esac
+  case $1 in cornell|caustic) echo bsdf nee mis light bdpt photon ppm ;; *) echo bsdf nee mis ;; esac
 }
 
 # spps_of NAME: the sample counts a scene runs at.
@@ -160,33 +162,37 @@ if grep -q "^caustic	" "$OUT/pt.tsv"; then
   done <"$OUT/pt.tsv"
 fi
 
-# Target 4 (issue 21): on the caustic, BDPT's time at the RMSE of MIS at
-# $TOP spp, round by round (log-log interpolation between BDPT's two
-# bracketing runs of that round), against MIS's time; over the whole image
-# (TSV pt.tsv) and over the floor (pt-floor.tsv).
-bdpt_target() {
-  local tsv=$1 what=$2 e_m t_m r_m xs='' k tm tb x v
+# Target 4 (issue 21): on the caustic, BDPT's (and progressive photon
+# mapping's) time at the RMSE of MIS at $TOP spp, round by round (log-log
+# interpolation between the method's two bracketing runs of that round),
+# against MIS's time; over the whole image (TSV pt.tsv) and over the floor
+# (pt-floor.tsv).
+beats_mis() {
+  local est=$1 tsv=$2 what=$3 e_m t_m r_m xs='' k tm tb x v name
+  name=$(case $est in bdpt) echo BDPT ;; *) echo "progressive photon mapping" ;; esac)
   read -r e_m t_m r_m <<<"$(awk -F'\t' -v top="$TOP" '$1 == "caustic" && $3 == "mis" && $4 == top { print $6, $5, $11 }' "$tsv")"
   [ -n "$e_m" ] || return 0
-  tb=$(table time-at "$tsv" caustic bdpt "$e_m" 0)
+  tb=$(table time-at "$tsv" caustic "$est" "$e_m" 0)
   if [ -z "$tb" ]; then
-    echo "caustic, $what: BDPT never reached MIS's RMSE at $TOP spp ($e_m): NOT MET" >>"$OUT/pt-targets.txt"
+    echo "caustic, $what: $name never reached MIS's RMSE at $TOP spp ($e_m): NOT MET" >>"$OUT/pt-targets.txt"
     return 0
   fi
   IFS=, read -r -a tms <<<"$r_m"
   for ((k = 1; k <= ${#tms[@]}; k++)); do
-    tm=$(table time-at "$tsv" caustic bdpt "$e_m" "$k")
+    tm=$(table time-at "$tsv" caustic "$est" "$e_m" "$k")
     xs+="$(ratio %.4g "${tms[k - 1]}" "${tm#<}") "
   done
   # shellcheck disable=SC2086
   x=$(printf %.1f "$(median $xs)")
   v=$(verdict "$x" ">=" 10)
   # shellcheck disable=SC2086
-  echo "caustic $csize, one thread, $what: MIS at $TOP spp: RMSE $e_m in $t_m s CPU; BDPT reaches it in $tb s (medians of $ROUNDS rounds taking turns): ${x}x less time ($(range %.1f $xs), the rounds' ratios) (target >= 10x): $v" >>"$OUT/pt-targets.txt"
+  echo "caustic $csize, one thread, $what: MIS at $TOP spp: RMSE $e_m in $t_m s CPU; $name reaches it in $tb s (medians of $ROUNDS rounds taking turns): ${x}x less time ($(range %.1f $xs), the rounds' ratios) (target >= 10x): $v" >>"$OUT/pt-targets.txt"
 }
 if [ -s "$OUT/pt-floor.tsv" ]; then
-  bdpt_target "$OUT/pt.tsv" "the whole image"
-  bdpt_target "$OUT/pt-floor.tsv" "the floor"
+  for est in bdpt ppm; do
+    beats_mis $est "$OUT/pt.tsv" "the whole image"
+    beats_mis $est "$OUT/pt-floor.tsv" "the floor"
+  done
 fi
 
 # Target 1: MIS against BSDF sampling at 256 spp on the Cornell box, round

@@ -1,5 +1,7 @@
 # Photon mapping (--estimator photon).  Its kd-tree (photons.c): the k
-# nearest photons are brute force's (tests/test_photons.c).  Its images,
+# nearest photons are brute force's (tests/test_photons.c); an estimate
+# counts the photons on the point's plane that took few enough rays, and
+# no others (tests/test_photon_estimate.c).  Its images,
 # whose bias is the density estimate's blur: in the furnace (inside a
 # glowing sphere of albedo .5 and Le 1.5) the mean is exact at -d 2 (no
 # photon counts there) and within 0.2% of Le (1 - a^(N+1)) / (1 - a) at
@@ -56,6 +58,16 @@ print('%.3f' % ((sa - sr) / sr if spot else 99))" "$1" "$TMP/ref.pfm"
 # shellcheck disable=SC2086 # CFLAGS holds several words
 $CC $CFLAGS -std=c99 -o "$TMP/test_photons" tests/test_photons.c photons.c -lm || { bad "tests/test_photons.c compiles"; exit 1; }
 "$TMP/test_photons"
+# shellcheck disable=SC2086
+$CC $CFLAGS -std=c99 -o "$TMP/test_estimate" tests/test_photon_estimate.c $RAY_PARTS -lm || bad "tests/test_photon_estimate.c compiles"
+cat >"$TMP/floor.sph" <<'SCENE'
+integrator path
+camera 0 5 -5   0 0 0   0 1 0   40
+tri -9 0 -9  9 0 9  9 0 -9     .8 .8 .8  .8 0 0 0 1
+tri -9 0 -9  -9 0 9  9 0 9     .8 .8 .8  .8 0 0 0 1
+0 3 0   1 1 1   .3   0 0 0 5 1
+SCENE
+"$TMP/test_estimate" "$TMP/floor.sph" || [ $? = 1 ] || bad "tests/test_photon_estimate.c: the floor scene did not load"
 
 furnace "photon mapped" 0.002 -n 16 --estimator photon --photons 100000
 
@@ -148,6 +160,26 @@ b = pfm(sys.argv[1])
 print(sum(1 for k in range(len(b) // 3) if [round(x, 6) for x in b[3 * k:3 * k + 3]] == [1.0, 0.85, 0.2]))" "$TMP/cdots.pfm")
 [ -n "$yellow" ] && [ "$yellow" -gt 0 ] && ok "--view photons on the caustic: $yellow pixels a caustic photon's yellow" \
   || bad "--view photons on the caustic: no caustic photon drawn ('$yellow')"
+# a plate over a lamp over a floor, seen from above: the photons on the
+# plate's underside and on the floor below it are hidden from the eye
+cat >"$TMP/plate.sph" <<'SCENE'
+integrator path
+background 0 0 0
+camera 0 10 0   0 0 0   0 0 1   60
+tri -20 0 -20  20 0 -20  20 0 20     .8 .8 .8  .8 0 0 0 1
+tri -20 0 -20  20 0 20  -20 0 20     .8 .8 .8  .8 0 0 0 1
+tri -2 2 -2  2 2 -2  2 2 2     .8 .8 .8  .8 0 0 0 1
+tri -2 2 -2  2 2 2  -2 2 2     .8 .8 .8  .8 0 0 0 1
+0 1 0   1 1 1   .2   0 0 0 20 1
+SCENE
+./ray "$TMP/plate.sph" -s 32x32 -n 1 --estimator photon --photons 5000 --view photons -o "$TMP/pl.pfm" 2>/dev/null
+read -r all under <<<"$(python3 -c "$PFM_PY
+b = pfm(sys.argv[1])
+dot = lambda k: [round(x, 6) for x in b[3 * k:3 * k + 3]] == [0.2, 0.5, 1.0]
+print(sum(dot(k) for k in range(32 * 32)), sum(dot(32 * j + i) for j in range(11, 21) for i in range(11, 21)))" "$TMP/pl.pfm")"
+[ -n "$all" ] && [ "$all" -gt 100 ] && [ "$under" = 0 ] \
+  && ok "--view photons: $all photons drawn on the floor, none on the plate that hides the lamp's (its underside's, the floor's below)" \
+  || bad "--view photons: '$under' of the plate's 100 pixels show a hidden photon ($all drawn)"
 ./ray scenes/cornell.sph -s 8x8 -n 1 --view photons -o "$TMP/v.pfm" 2>"$TMP/err"
 code=$?
 [ $code = 2 ] && grep -q "photon mapping's photons" "$TMP/err" && ok "--view photons without photon mapping: refused (exit 2)" \

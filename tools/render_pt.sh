@@ -28,3 +28,7 @@ for st in 0,5 1,4 2,3 3,2 4,1; do
 done
 # photon mapping beside them (the README's "Photon mapping")
 ./ray -s 320x240 -n 20 --estimator photon --stats -o docs/pt/caustic-photon.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic photon: /'
+# progressive photon mapping at about the same CPU time, and the photons
+# themselves over the picture (the README's "Progressive photon mapping")
+./ray -s 320x240 -n 64 --estimator ppm --stats -o docs/pt/caustic-ppm.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic ppm: /'
+./ray -s 320x240 -n 4 --estimator photon --photons 20000 --view photons -o docs/pt/caustic-photons.png scenes/caustic.sph
