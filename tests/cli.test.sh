@@ -167,7 +167,7 @@ assert px('$TMP/normal.ppm', 4, 4) == (128, 0, 128), px('$TMP/normal.ppm', 4, 4)
 " && ok "--view steps: 11 tests through the loop on the fixed scale; --view normal: the normal as colour" \
   || bad "--view steps or normal"
 ./ray --view heat -o "$TMP/h.ppm" "$TMP/view.sph" 2>"$TMP/err"; rc=$?
-[ $rc = 2 ] && grep -q "steps, normal, depth or samples" "$TMP/err" && ok "--view heat: exit 2, the choices listed" \
+[ $rc = 2 ] && grep -q "steps, normal, depth, samples or photons" "$TMP/err" && ok "--view heat: exit 2, the choices listed" \
   || bad "--view heat: exit $rc"
 
 # Numbers whose products overflow: refused with their file:line (the fuzz

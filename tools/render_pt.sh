@@ -31,4 +31,4 @@ done
 # progressive photon mapping at about the same CPU time, and the photons
 # themselves over the picture (the README's "Progressive photon mapping")
 ./ray -s 320x240 -n 64 --estimator ppm --stats -o docs/pt/caustic-ppm.png scenes/caustic.sph 2>&1 | grep '^time' | sed 's/^/caustic ppm: /'
-./ray -s 320x240 -n 4 --estimator photon --photons 20000 --view photons -o docs/pt/caustic-photons.png scenes/caustic.sph
+./ray -s 320x240 -n 16 --estimator photon --photons 10000 --view photons -o docs/pt/caustic-photons.png scenes/caustic.sph
