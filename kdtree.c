@@ -595,8 +595,13 @@ static int sort_events(kd_event *e, long n)
     kd_event *tmp, *from = e, *to;
     long count[256], i;
     int d, k;
-    if (n < 64) {
-        qsort(e, n, sizeof *e, event_cmp);
+    if (n < 64) {  /* by insertion: the order is total, so the same list */
+        for (i = 1; i < n; i++) {
+            kd_event x = e[i];
+            long j = i;
+            for (; j > 0 && event_cmp(&x, &e[j - 1]) < 0; j--) e[j] = e[j - 1];
+            e[j] = x;
+        }
         return 1;
     }
     to = tmp = malloc(n * sizeof *e);
@@ -688,15 +693,30 @@ typedef struct {
     long nl, nr;  /* primitives on each side, by their boxes */
 } kd_split;
 
-/* Expected cost of cutting v at pos, with nl and nr primitives per side. */
-static double sah(const kd_box *v, int axis, float pos, long nl, long nr,
-                  double area)
+/* Surface area of a box with sides dx, dy, dz: box_area's own sum. */
+static double area3(double dx, double dy, double dz)
 {
-    kd_box l = *v, r = *v;
-    double cost;
-    l.hi[axis] = pos;
-    r.lo[axis] = pos;
-    cost = COST_STEP + COST_TEST * (box_area(&l) * nl + box_area(&r) * nr) / area;
+    return 2 * (dx * dy + dy * dz + dz * dx);
+}
+
+/* The two children's areas when v is cut on `axis` at pos.  The sweep asks
+ * at every event, so v's sides come once per axis in d (d[i] = hi - lo, in
+ * double) and only the cut side changes: the same sums, in the same order,
+ * as box_area of the children, so the same bits. */
+static void child_areas(const kd_box *v, const double d[3], int axis, float pos,
+                        double *al, double *ar)
+{
+    double l = (double)pos - v->lo[axis], r = (double)v->hi[axis] - pos;
+    if (axis == 0) *al = area3(l, d[1], d[2]), *ar = area3(r, d[1], d[2]);
+    else if (axis == 1) *al = area3(d[0], l, d[2]), *ar = area3(d[0], r, d[2]);
+    else *al = area3(d[0], d[1], l), *ar = area3(d[0], d[1], r);
+}
+
+/* Expected cost of a cut whose children have areas al and ar and hold nl
+ * and nr primitives, in a cell of the given area. */
+static double sah(double al, double ar, long nl, long nr, double area)
+{
+    double cost = COST_STEP + COST_TEST * (al * nl + ar * nr) / area;
     return nl == 0 || nr == 0 ? cost * EMPTY_BONUS : cost;
 }
 
@@ -712,11 +732,13 @@ static void offer(kd_split *best, int axis, float pos, double cost, int planar_l
 
 /* Price one plane twice, with the primitives lying in it on either side
  * (Wald & Havran 2006 keep the cheaper; on a tie, left). */
-static void consider(kd_split *best, const kd_box *v, int axis, float pos,
-                     long nl, long np, long nr, double area)
+static void consider(kd_split *best, const kd_box *v, const double d[3], int axis,
+                     float pos, long nl, long np, long nr, double area)
 {
-    double left = sah(v, axis, pos, nl + np, nr, area);
-    double right = sah(v, axis, pos, nl, np + nr, area);
+    double al, ar, left, right;
+    child_areas(v, d, axis, pos, &al, &ar);
+    left = sah(al, ar, nl + np, nr, area);
+    right = sah(al, ar, nl, np + nr, area);
     if (left <= right) offer(best, axis, pos, left, 1, nl + np, nr);
     else offer(best, axis, pos, right, 0, nl, np + nr);
 }
@@ -728,13 +750,15 @@ static void consider(kd_split *best, const kd_box *v, int axis, float pos,
  * longer test them, only rays that reach the face.  That is why such a
  * plane is priced, though well_inside (below) leaves other planes on a
  * face out. */
-static void consider_face(kd_split *best, const kd_box *v, int axis,
-                          float pos, long nl, long np, long nr, double area)
+static void consider_face(kd_split *best, const kd_box *v, const double d[3],
+                          int axis, float pos, long nl, long np, long nr, double area)
 {
+    double al, ar;
+    child_areas(v, d, axis, pos, &al, &ar);
     if (pos == v->lo[axis])
-        offer(best, axis, pos, sah(v, axis, pos, nl + np, nr, area), 1, nl + np, nr);
+        offer(best, axis, pos, sah(al, ar, nl + np, nr, area), 1, nl + np, nr);
     else
-        offer(best, axis, pos, sah(v, axis, pos, nl, np + nr, area), 0, nl, np + nr);
+        offer(best, axis, pos, sah(al, ar, nl, np + nr, area), 0, nl, np + nr);
 }
 
 /* Other planes on or within a few float steps of a face of the cell are
@@ -756,6 +780,9 @@ static void sweep(const kd_list *L, int axis, const kd_box *v, double area,
 {
     const kd_event *e = L->ev[axis];
     long n = L->n[axis], i = 0, nl = 0, nr = L->count;
+    double d[3];
+    int k;
+    for (k = 0; k < 3; k++) d[k] = (double)v->hi[k] - v->lo[k];
     while (i < n) {
         float pos = e[i].pos;
         long ends = 0, planars = 0, starts = 0;
@@ -764,10 +791,10 @@ static void sweep(const kd_list *L, int axis, const kd_box *v, double area,
         for (; i < n && e[i].pos == pos && ev_type(&e[i]) == START; i++) starts++;
         nr -= ends + planars;
         if (well_inside(pos, v->lo[axis], v->hi[axis]))
-            consider(best, v, axis, pos, nl, planars, nr, area);
+            consider(best, v, d, axis, pos, nl, planars, nr, area);
         else if (planars > 0 && v->lo[axis] < v->hi[axis]
                  && (pos == v->lo[axis] || pos == v->hi[axis]))
-            consider_face(best, v, axis, pos, nl, planars, nr, area);
+            consider_face(best, v, d, axis, pos, nl, planars, nr, area);
         nl += starts + planars;
     }
 }
@@ -845,9 +872,25 @@ static void recall_boxes(const kd_builder *b, const kd_list *L, kd_box *cut)
  * it, and must not be dropped for that.  The cell goes to the caller's
  * coordinates in one rounded addition, which cannot cross a coordinate of
  * the caller's (rounding is monotonic), so it still holds whatever it held. */
-static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
-                     const kd_box *cell, kd_box *out)
+typedef struct {
+    kd_box box;                /* the child cell, in the frame */
+    double lo[3], hi[3];       /* grown by two float steps, in the caller's coordinates */
+} kd_cell;
+
+static void grow_cell(const kd_builder *b, const kd_box *cell, kd_cell *out)
 {
+    int a;
+    out->box = *cell;
+    for (a = 0; a < 3; a++) {
+        out->lo[a] = b->c[a] + nextafterf(nextafterf(cell->lo[a], -FLT_MAX), -FLT_MAX);
+        out->hi[a] = b->c[a] + nextafterf(nextafterf(cell->hi[a], FLT_MAX), FLT_MAX);
+    }
+}
+
+static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
+                     const kd_cell *grown, kd_box *out)
+{
+    const kd_box *cell = &grown->box;
     kd_box old = *box;
     int a;
     for (a = 0; a < 3; a++) {
@@ -856,12 +899,8 @@ static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
     }
     *out = old;
     if (b->p->clip) {
-        double clo[3], chi[3], lo[3], hi[3];
-        for (a = 0; a < 3; a++) {
-            clo[a] = b->c[a] + nextafterf(nextafterf(cell->lo[a], -FLT_MAX), -FLT_MAX);
-            chi[a] = b->c[a] + nextafterf(nextafterf(cell->hi[a], FLT_MAX), FLT_MAX);
-        }
-        if (!b->p->clip(b->p->user, prim, clo, chi, lo, hi)) return 0;
+        double lo[3], hi[3];
+        if (!b->p->clip(b->p->user, prim, grown->lo, grown->hi, lo, hi)) return 0;
         if (!make_box(lo, hi, b->c, out)) return 1;  /* NaN: keep the old box */
         for (a = 0; a < 3; a++) {
             out->lo[a] = clampf(out->lo[a], old.lo[a], old.hi[a]);
@@ -872,20 +911,28 @@ static int clip_prim(const kd_builder *b, int prim, const kd_box *box,
 }
 
 /* Merge the events of the primitives that went wholly to one side (already
- * sorted) with the fresh events of the cut primitives (sorted here). */
+ * sorted) with the fresh events of the cut primitives (sorted here), for
+ * both children in one pass over the node's events. */
 static void merge(const kd_event *old, long n, const int *side,
-                  int want, const kd_event *fresh, long nf, kd_event *out,
-                  long *nout)
+                  const kd_list *fl, const kd_list *fr, int a, kd_list *left,
+                  kd_list *right)
 {
-    long i = 0, j = 0, k = 0;
-    for (;;) {
-        while (i < n && side[ev_prim(&old[i])] != want) i++;
-        if (i == n) break;
-        if (j < nf && event_cmp(&fresh[j], &old[i]) < 0) out[k++] = fresh[j++];
-        else out[k++] = old[i++];
+    const kd_event *f[2];
+    kd_event *out[2];
+    long nf[2], j[2] = { 0, 0 }, k[2] = { 0, 0 }, i;
+    int c;
+    f[0] = fl->ev[a], nf[0] = fl->n[a], out[0] = left->ev[a];
+    f[1] = fr->ev[a], nf[1] = fr->n[a], out[1] = right->ev[a];
+    for (i = 0; i < n; i++) {
+        int sd = side[ev_prim(&old[i])];
+        if (sd != LEFT && sd != RIGHT) continue;
+        c = sd == RIGHT;
+        while (j[c] < nf[c] && event_cmp(&f[c][j[c]], &old[i]) < 0) out[c][k[c]++] = f[c][j[c]++];
+        out[c][k[c]++] = old[i];
     }
-    while (j < nf) out[k++] = fresh[j++];
-    *nout = k;
+    for (c = 0; c < 2; c++)
+        while (j[c] < nf[c]) out[c][k[c]++] = f[c][j[c]++];
+    left->n[a] = k[0], right->n[a] = k[1];
 }
 
 /* Events for the cut primitives, clipped to each child: the only events
@@ -898,15 +945,17 @@ static int cut_events(const kd_builder *b, const kd_list *L, const kd_box *cut,
     const kd_event *e = L->ev[0];
     long i;
     int a;
+    kd_cell gl, gr;
+    grow_cell(b, vl, &gl), grow_cell(b, vr, &gr);
     if (!alloc_list(fl, 2 * ncut)) return 0;
     if (!alloc_list(fr, 2 * ncut)) return free_list(fl), 0;
     for (i = 0; i < L->n[0]; i++) {
         int prim = ev_prim(&e[i]), k = b->side[prim];
         kd_box box;
         if (ev_type(&e[i]) == END || k < 0) continue;
-        if (clip_prim(b, prim, &cut[k], vl, &box))
+        if (clip_prim(b, prim, &cut[k], &gl, &box))
             add_events(fl->ev, fl->n, prim, &box), fl->count++;
-        if (clip_prim(b, prim, &cut[k], vr, &box))
+        if (clip_prim(b, prim, &cut[k], &gr, &box))
             add_events(fr->ev, fr->n, prim, &box), fr->count++;
     }
     for (a = 0; a < 3; a++)
@@ -917,18 +966,21 @@ static int cut_events(const kd_builder *b, const kd_list *L, const kd_box *cut,
     return 1;
 }
 
-/* Events of the primitives going wholly to one side, on axis a; on axis 0
- * counting starts and planars only gives the number of primitives. */
-static long count_side(const kd_builder *b, const kd_list *L, int a, int want,
-                       int prims_only)
+/* Events of the primitives going wholly to each side, on axis a: n[0]
+ * left, n[1] right; on axis 0 also the primitives themselves (their starts
+ * and planars) in prims[0] and prims[1]. */
+static void count_sides(const kd_builder *b, const kd_list *L, int a, long n[2],
+                        long prims[2])
 {
-    long i, k = 0;
+    long i;
+    n[0] = n[1] = prims[0] = prims[1] = 0;
     for (i = 0; i < L->n[a]; i++) {
         const kd_event *e = &L->ev[a][i];
-        if (prims_only && ev_type(e) == END) continue;
-        k += b->side[ev_prim(e)] == want;
+        int sd = b->side[ev_prim(e)];
+        if (sd != LEFT && sd != RIGHT) continue;
+        n[sd == RIGHT]++;
+        prims[sd == RIGHT] += ev_type(e) != END;
     }
-    return k;
 }
 
 /* Point ev[] at the list's place on its stack, wherever the stack is now. */
@@ -1007,11 +1059,12 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
     ok = cut_events(b, L, cut, ncut, vl, vr, &fl, &fr);
     free(cut);
     if (!ok) return 0;
-    left->count = count_side(b, L, 0, LEFT, 1) + fl.count;
-    right->count = count_side(b, L, 0, RIGHT, 1) + fr.count;
     for (a = 0; a < 3; a++) {
-        nl[a] = count_side(b, L, a, LEFT, 0) + fl.n[a];
-        nr[a] = count_side(b, L, a, RIGHT, 0) + fr.n[a];
+        long n[2], prims[2];
+        count_sides(b, L, a, n, prims);
+        if (a == 0) left->count = prims[0] + fl.count, right->count = prims[1] + fr.count;
+        nl[a] = n[0] + fl.n[a];
+        nr[a] = n[1] + fr.n[a];
         total += nl[a] + nr[a];
     }
     from = b->top[on];
@@ -1026,10 +1079,7 @@ static int split_lists(kd_builder *b, kd_list *L, const kd_split *s,
     left->on = right->on = on;
     attach(b, left), attach(b, right);
     for (a = 0; a < 3; a++) {
-        merge(L->ev[a], L->n[a], b->side, LEFT, fl.ev[a], fl.n[a],
-              left->ev[a], &left->n[a]);
-        merge(L->ev[a], L->n[a], b->side, RIGHT, fr.ev[a], fr.n[a],
-              right->ev[a], &right->n[a]);
+        merge(L->ev[a], L->n[a], b->side, &fl, &fr, a, left, right);
         if (L->own) free(L->ev[a]), L->ev[a] = NULL;
     }
     free_list(&fl), free_list(&fr);
@@ -1061,6 +1111,18 @@ static int int_cmp(const void *pa, const void *pb)
     return (a > b) - (a < b);
 }
 
+/* Most leaves hold a few primitives: sorted by insertion, without qsort's
+ * calls through a pointer. */
+static void sort_few(int *v, long n)
+{
+    long i, j;
+    for (i = 1; i < n; i++) {
+        int x = v[i];
+        for (j = i; j > 0 && v[j - 1] > x; j--) v[j] = v[j - 1];
+        v[j] = x;
+    }
+}
+
 /* A leaf lists its primitives in increasing order: deterministic, and kind
  * to the caches when primitives are stored in a sensible order. */
 static void make_leaf(kd_builder *b, long at, const kd_list *L)
@@ -1082,7 +1144,8 @@ static void make_leaf(kd_builder *b, long at, const kd_list *L)
     }
     for (i = 0; i < L->n[0]; i++)
         if (ev_type(&e[i]) != END) b->refs[b->nrefs++] = ev_prim(&e[i]);
-    if (L->count > 1) qsort(b->refs + start, L->count, sizeof(int), int_cmp);
+    if (L->count > 16) qsort(b->refs + start, L->count, sizeof(int), int_cmp);
+    else sort_few(b->refs + start, L->count);
     b->nodes[at].u.count = (uint32_t)L->count;
     b->nodes[at].bits = (uint32_t)start << 2 | LEAF;
 }
