@@ -738,7 +738,7 @@ static void consider(kd_split *best, const kd_box *v, const double d[3], int axi
     double al, ar, left, right;
     child_areas(v, d, axis, pos, &al, &ar);
     left = sah(al, ar, nl + np, nr, area);
-    right = sah(al, ar, nl, np + nr, area);
+    right = np > 0 ? sah(al, ar, nl, np + nr, area) : left;  /* the same sum */
     if (left <= right) offer(best, axis, pos, left, 1, nl + np, nr);
     else offer(best, axis, pos, right, 0, nl, np + nr);
 }
