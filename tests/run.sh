@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.." || exit 2
 jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 out=$(mktemp -d "${TMPDIR:-/tmp}/testrun.XXXXXX")
 trap 'rm -rf "$out"' EXIT
-longest_first="tests/accel.test.sh tests/ray.test.sh tests/io.test.sh tests/golf.test.sh tests/pt.test.sh tests/photons.test.sh tests/bdpt.test.sh tests/motion.test.sh tests/kdbuild.test.sh tests/dist.test.sh"
+longest_first="tests/photons.test.sh tests/pt.test.sh tests/ray.test.sh tests/accel.test.sh tests/bdpt.test.sh tests/light.test.sh tests/kdbuild.test.sh tests/split.test.sh tests/motion.test.sh tests/sampler.test.sh tests/dist.test.sh tests/io.test.sh tests/hooks.test.sh tests/golf.test.sh"
 scripts=$longest_first
 for t in tests/*.test.sh; do
   case " $longest_first " in *" $t "*) ;; *) scripts="$scripts $t";; esac
