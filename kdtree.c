@@ -1145,7 +1145,7 @@ static void make_leaf(kd_builder *b, long at, const kd_list *L)
     for (i = 0; i < L->n[0]; i++)
         if (ev_type(&e[i]) != END) b->refs[b->nrefs++] = ev_prim(&e[i]);
     if (L->count > 16) qsort(b->refs + start, L->count, sizeof(int), int_cmp);
-    else sort_few(b->refs + start, L->count);
+    else if (L->count > 1) sort_few(b->refs + start, L->count);  /* refs may still be NULL */
     b->nodes[at].u.count = (uint32_t)L->count;
     b->nodes[at].bits = (uint32_t)start << 2 | LEAF;
 }
