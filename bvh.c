@@ -851,6 +851,20 @@ static uint32_t collapse(const bvh_node *bin, uint32_t at, bvh_node4 *out, long 
     return me;
 }
 
+/* How many four-way nodes collapse makes from binary node `at`: the
+ * tree's block is then no larger than it. */
+static long count_collapsed(const bvh_node *bin, uint32_t at)
+{
+    uint32_t lane[4];
+    long count = 1;
+    int n, k;
+    if (bin[at].count) return 1;
+    n = gather_lanes(bin, at, lane);
+    for (k = 0; k < n; k++)
+        if (!bin[lane[k]].count) count += count_collapsed(bin, lane[k]);
+    return count;
+}
+
 /* The SAH model's expected cost of the four-way tree for a ray that meets
  * the scene box: each lane's area over the scene box's, times COST_STEP for
  * a node (its four boxes tested) or COST_TEST per primitive of a leaf.  It
@@ -913,12 +927,12 @@ static bvh *alloc_tree(long nnodes, long nprims)
     return t;
 }
 
-/* The binary tree collapsed to four-way nodes: at most one per binary
- * inner node, or one for a root that is a leaf. */
+/* The binary tree collapsed to four-way nodes: about one for every three
+ * binary inner nodes, or one for a root that is a leaf. */
 static bvh *finish(bvh_builder *b, const int *ids, long nprims)
 {
-    long inner = b->nnodes ? (b->nnodes - 1 - b->leaves) : 0, used = 0, depth = 0;
-    bvh *t = alloc_tree(b->nnodes ? (inner > 0 ? inner : 1) : 0, nprims);
+    long used = 0, depth = 0;
+    bvh *t = alloc_tree(b->nnodes ? count_collapsed(b->nodes, 0) : 0, nprims);
     if (!t) return NULL;
     if (b->nnodes) collapse(b->nodes, 0, t->nodes, &used, 0, &depth);
     t->nnodes = used;
@@ -968,8 +982,7 @@ bvh *bvh_build(int n, const prims *p, int method)
     if (n < 0) n = 0;
     b.ref = malloc(((size_t)n + 1) * sizeof *b.ref);
     b.nodes = calloc(2 * (size_t)n + 2, sizeof *b.nodes);
-    ids = malloc(((size_t)n + 1) * sizeof *ids);
-    if (b.ref && b.nodes && ids) {
+    if (b.ref && b.nodes) {
         double lo[3], hi[3];
         /* the frame's centre from at most about 1024 of the primitives:
          * any centre near the scene will do, since the margins follow the
@@ -982,10 +995,17 @@ bvh *bvh_build(int n, const prims *p, int method)
             b.nnodes = 2;   /* the root, and the padding that aligns the pairs */
             build_node(&b, 0, 0, m, 0, &box, &cbox);
         }
-        for (k = 0; k < m; k++) ids[k] = b.ref[k].id;
-        t = finish(&b, ids, m);
+        /* the records go before the four-way tree is made: the build's
+         * peak of memory is then the larger of the two, not their sum */
+        ids = malloc(((size_t)m + 1) * sizeof *ids);
+        if (ids) {
+            for (k = 0; k < m; k++) ids[k] = b.ref[k].id;
+            free(b.ref), b.ref = NULL;
+            t = finish(&b, ids, m);
+            free(ids);
+        }
     }
-    free(b.ref), free(b.nodes), free(ids);
+    free(b.ref), free(b.nodes);
     if (t) t->info.build_seconds = (double)(clock() - start) / CLOCKS_PER_SEC;
     return t;
 }

@@ -24,15 +24,18 @@
  *            exactly; in the first four no vertex is in more than 2 log2 n + 2
  *            of them (3 log2 n for the random ones).
  *   memory   a 49k-triangle cube-sphere: kdtree.c holds at most 128 bytes a
- *            triangle at its peak (the old build: 170).
+ *            triangle at its peak (the old build: 170), and bvh.c at most
+ *            120 (140 while its build's records were kept until the
+ *            four-way tree was made).
  *
  * On every scene with a tree, rays of many kinds (aimed anywhere, at the
  * point where the fan's triangles meet, at vertices, along an axis, in the
  * plane, from either side) must find through the tree exactly what the loop
  * over all objects finds: the same object, bit for bit the same t.
  *
- * kdtree.c is compiled for this test with malloc, realloc and free renamed
- * kdb_malloc, kdb_realloc and kdb_free (tests/kdbuild.test.sh), and these
+ * kdtree.c and bvh.c are compiled for this test with malloc, calloc, realloc
+ * and free renamed kdb_malloc, kdb_calloc, kdb_realloc and kdb_free
+ * (tests/kdbuild.test.sh), and these
  * count the bytes it holds, room it asked for but has not used included:
  * the same count on every run, unlike the process's resident memory.
  * Prints "PASS ..." or "FAIL ..." lines and exits 1 if a check failed. */
@@ -41,6 +44,7 @@
 #undef main
 
 void *kdb_malloc(size_t n);
+void *kdb_calloc(size_t count, size_t size);
 void *kdb_realloc(void *p, size_t n);
 void kdb_free(void *p);
 
@@ -60,6 +64,17 @@ void *kdb_malloc(size_t n)
     held += n;
     if (held > peak) peak = held;
     return h + 1;
+}
+
+/* Counted whole, though the system maps the pages of a big zeroed block
+ * only as they are written: a bound on what is resident. */
+void *kdb_calloc(size_t count, size_t size)
+{
+    void *p;
+    if (size && count > (size_t)-1 / size) return NULL;
+    p = kdb_malloc(count * size);
+    if (p) memset(p, 0, count * size);
+    return p;
 }
 
 void kdb_free(void *p)
@@ -456,6 +471,15 @@ static void test_memory(void)
     sprintf(msg, "%d triangles: peak %.1f bytes a triangle held by kdtree.c (bound 128), "
             "the tree %.1f", s.ntri, (double)bytes / s.ntri, (double)k.bytes / s.ntri);
     report(bytes <= 128.0 * s.ntri, "memory: the build's peak on a cube-sphere", msg);
+    held = peak = 0;
+    if (!build_accel(&s, "bvh") || !s.accel.bvh) {
+        report(0, "memory: bvh_build", "returned NULL");
+        free_scene(&s);
+        return;
+    }
+    sprintf(msg, "%d triangles: peak %.1f bytes a triangle held by bvh.c (bound 120)", s.ntri,
+            (double)peak / s.ntri);
+    report(peak <= 120.0 * s.ntri, "memory: the BVH build's peak on a cube-sphere", msg);
     free_scene(&s);
 }
 

@@ -37,6 +37,8 @@
 #            mapping's, --view photons)
 #     light  tests/light.test.sh (tests/test_light.c: Arvo's sampler and the
 #            light tree; the light choice's images)
+#     kdbuild  tests/kdbuild.test.sh (the kd build's budget on fans, the
+#            ear clipper, what kdtree.c and bvh.c hold at their peaks)
 #
 # A test program that crashes or exits non-zero fails too (a FAIL line
 # says so).  The probe, for a mutant the tests let through: for pt,
@@ -70,6 +72,7 @@ tests_of() {
     bdpt) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/bdpt.test.sh >out 2>&1 || echo 'FAIL tests/bdpt.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     photon) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/photons.test.sh >out 2>&1 || echo 'FAIL tests/photons.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     light) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/light.test.sh >out 2>&1 || echo 'FAIL tests/light.test.sh exited' >>out; ! grep '^FAIL' out" ;;
+    kdbuild) echo "bash tests/kdbuild.test.sh >out 2>&1 || echo 'FAIL tests/kdbuild.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     bvh|grid)
       local structs=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
       echo "$build_accel; for a in $structs; do for s in $scenes; do
@@ -108,6 +111,7 @@ probe_of() {
               for f in lights100 cornell veach lamp soft; do for c in importance power; do
                 ./ray --pt -t 1 -s 24x16 -n 4 --light-choice \$c -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f \$c; cksum <p.pfm;
               done; done" ;;
+    kdbuild) echo "bash tests/kdbuild.test.sh 2>&1 | sed 's/[0-9][0-9.]* s\\b//'" ;;
     bvh|grid)
       local structs=$1 accel=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
       echo "$build_accel; for a in $structs; do for s in $scenes; do ACCEL_RAYS=50000 ./t \$a \$s 2>&1; done; done |
