@@ -69,7 +69,9 @@ void usage(FILE *to)
           "             4 where its 8 neighbours' first 4 agree with its own\n"
           "  --no-skip  skip nothing the plain algorithm does: Whitted's rays of tiny\n"
           "             weight, shadow rays to lights behind a surface, the shadow cache,\n"
-          "             the loop instead of a structure for a few objects, --adaptive\n"
+          "             the loop instead of a structure for a few objects, --adaptive;\n"
+          "             the path tracer's shadow rays to the parts of a glowing sphere\n"
+          "             that an opaque sphere hides (smallpt's lamp in its ceiling)\n"
           "  --crop X0,Y0,X1,Y1  render only the pixels X0 <= x < X1, Y0 <= y < Y1,\n"
           "             with the values a whole render gives them\n"
           "  --tile I/N job I (from 0) of N: the I-th of N bands of rows\n"
@@ -85,7 +87,8 @@ void usage(FILE *to)
           "  --accel A  kd (the kd-tree), bvh (bounding volume hierarchy), grid\n"
           "             (uniform grid), none (test every object) or auto (default:\n"
           "             the scene's `accel` line, else from 8 objects up the one that\n"
-          "             renders a 32x32 probe of the image fastest, its build included)\n"
+          "             renders a 32x32 probe of the image fastest, its build included;\n"
+          "             below 64 objects the loop over them all takes its turn too)\n"
           "  --view V   instead of the picture, what a ray through each pixel's centre\n"
           "             meets: steps (the structure's work: nodes or cells plus tests,\n"
           "             black 0, blue 25, red 50, yellow 100, white 200), normal, depth;\n"
@@ -509,8 +512,8 @@ static void print_stats_kv(FILE *f, const Stats *st)
             "rays_refracted %llu\nrays_bounced %llu\nrays_cut %llu\nsamples_discarded %llu\n",
             all_rays(st), st->primary, st->shadow, st->reflected, st->refracted, st->bounced,
             st->cut, st->discarded);
-    fprintf(f, "no_skip %d\nskipped_behind %llu\nskipped_faint %llu\nskipped_dim %llu\n", st->no_skip, st->behind,
-            st->faint, st->dim);
+    fprintf(f, "no_skip %d\nskipped_behind %llu\nskipped_faint %llu\nskipped_dim %llu\nclipped_lights %d\n",
+            st->no_skip, st->behind, st->faint, st->dim, st->clipped);
     if (st->adaptive > 0)
         fprintf(f, "adaptive_steps %g\nsamples_taken %llu\nsamples_per_pixel %.4f\nsamples_min %d\nsamples_max %d\n",
                 st->adaptive, st->samples, (double)st->samples / ((double)st->w * st->h), st->spp_min, st->spp_max);
@@ -582,7 +585,10 @@ void print_stats(FILE *f, const Stats *st, int kv)
     if (!st->path && st->cut)
         fprintf(f, "budget     %llu reflected or refracted rays not traced: past %d a primary ray\n",
                 st->cut, st->budget);
-    if (!st->path && st->no_skip) fprintf(f, "skips      none (--no-skip)\n");
+    if (st->no_skip) fprintf(f, "skips      none (--no-skip)\n");
+    if (st->path && !st->no_skip)
+        fprintf(f, "skips      %d glowing spheres sampled only where opaque spheres cutting them leave them"
+                " to be seen\n", st->clipped);
     if (!st->path && !st->no_skip)
         fprintf(f, "skips      %llu shadow rays to lights behind, %llu to lights too dim to change the pixel"
                 " by a quarter step, %llu reflected or refracted rays of weight under 1/512; blockers tried"

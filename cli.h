@@ -84,6 +84,7 @@ typedef struct {
     int budget;                     /* Whitted: secondary rays a primary ray may spawn */
     double adaptive;                /* --adaptive's E, or 0 */
     int no_skip;                    /* --no-skip: every skip off */
+    int clipped;                    /* the path tracer: glowing spheres sampled where clips leave them seen */
     unsigned long long behind, faint, dim;  /* Whitted's skips: shadow rays to lights behind, */
                                         /* faint rays, shadow rays to lights too dim */
     unsigned long long samples;     /* the samples all pixels took */

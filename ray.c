@@ -224,7 +224,17 @@ typedef struct {
     int type, obj;
     vec pos, intensity;       /* a point light's place and intensity I (radiance: I / d^2) */
     int inward;               /* a sphere that light paths leave inward too (see inside_seen) */
+    int clip, nclips;         /* a sphere: its clips, Lights' clip[clip .. clip + nclips - 1] */
 } Emitter;
+
+/* An opaque sphere (obj) that cuts a glowing sphere, as smallpt's ceiling
+ * cuts its lamp: seen from the lamp's centre, the lamp's part inside it is
+ * the cap of directions u with u . axis >= 1 - in (axis towards the
+ * sphere's centre), the part outside it the cap u . axis <= out - 1.  A
+ * point inside the sphere can see only the first, a point outside only the
+ * second: the way to the other crosses the sphere's opaque surface
+ * (visible_cap). */
+typedef struct { int obj; vec axis; real in, out; } Clip;
 
 /* A Scene holds four things, each of its own: what the file describes
  * (the objects, the camera, the lights as Whitted sees them), the render's
@@ -282,6 +292,7 @@ typedef struct {
     int nnode, root;          /* node[root] its root (-1: no such light) */
     int *leaf;                /* leaf[l]: light l's node */
     int *emitter;             /* emitter[object]: its light, or -1 */
+    Clip *clip; int nclip;    /* the opaque spheres that cut glowing ones (find_clips) */
 } Lights;
 
 /* The structure that finds hits. */
@@ -614,6 +625,9 @@ static int down_the_tree(const Scene *s, vec x, vec n, int by_power, real u, rea
 static int choose_light(const Scene *s, vec x, vec n, real u, real *chance);
 static real light_choice(const Scene *s, int l, vec x, vec n);
 static real tree_chance(const Scene *s, int l, vec x, vec n, int by_power);
+static void find_clips(Scene *s);
+static int clipped_lights(const Scene *s);
+static int visible_cap(const Scene *s, int l, vec x, vec n, vec *axis, real *cap);
 static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u, real v,
                           vec *wi, real *dist, vec *Le, real *pdf);
 static int light_visible(const Scene *s, const Hit *h, int l, vec wi, real dist, Worker *wk);
@@ -664,6 +678,8 @@ static int sphere_clip(const Sphere *sp, const double blo[3], const double bhi[3
                        double lo[3], double hi[3]);
 static real sphere_sample(const Sphere *sp, vec x, real u, real v, vec *wi, real *dist);
 static real sphere_pdf(const Sphere *sp, vec x, vec y);
+static real cap_sample(const Sphere *sp, vec axis, real cap, vec x, real u, real v, vec *wi, real *dist);
+static real cap_pdf(const Sphere *sp, vec axis, real cap, vec x, vec y);
 static void add_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat);
 static int add_checked_cone(Scene *s, vec base, real rb, vec apex, real ra, int mat, char *why);
 static real hit_cone(const Cone *c, const Ray *r, real tmin);
@@ -2822,6 +2838,7 @@ static void add_emitter(Scene *s, int type, int obj, vec pos, vec intensity, rea
     L->emit[L->nemit].pos = pos;
     L->emit[L->nemit].intensity = intensity;
     L->emit[L->nemit].inward = type == SPHERE_LIGHT && inside_seen(s, obj);
+    L->emit[L->nemit].clip = L->emit[L->nemit].nclips = 0;
     if (obj >= 0) L->emitter[obj] = L->nemit;
     L->nemit++;
     if (type == SKY_LIGHT) return;
@@ -2904,10 +2921,113 @@ static void prepare_lights(Scene *s)
     L->nnode = L->nemit;                                 /* the leaves, then the inner nodes */
     L->root = L->nemit > 0 ? light_tree(L, order, L->nemit, -1) : -1;
     free(order);
+    find_clips(s);
     if (luminance(s->background) > 0) {
         s->lights.sky = s->lights.nemit;
         add_emitter(s, SKY_LIGHT, -1, v3(0, 0, 0), v3(0, 0, 0), 0);
     }
+}
+
+/* The clips of each glowing sphere at rest: the opaque spheres at rest
+ * whose surfaces cross its own.  A few a light are enough, since each alone
+ * bounds what a point can see: those with the smallest caps are kept (a
+ * wall may cut off half the lamp, and the ceiling all but a disc); and
+ * where lights times spheres are too many to pair up, or with --no-skip,
+ * none are looked for (the lights are then sampled whole: more shadow rays
+ * blocked, the same mean).  Each cap's
+ * height, from the lecture's cosine rule (d^2 = R^2 + rho^2 - 2 R rho cos)
+ * written as products that do not cancel, is grown by a bound on its
+ * rounding, so that no point a ray can meet falls outside it. */
+#define MAX_CLIPS 4
+#define CLIP_PAIRS 20000000.0
+static real clip_size(const Clip *c) { return fmin(c->in, c->out); }
+
+/* Of light e's clips, the one whose smaller cap is the largest. */
+static Clip *widest_clip(Lights *L, const Emitter *e)
+{
+    Clip *widest = &L->clip[e->clip];
+    int i;
+    for (i = e->clip + 1; i < e->clip + e->nclips; i++)
+        if (clip_size(&L->clip[i]) > clip_size(widest)) widest = &L->clip[i];
+    return widest;
+}
+
+static void find_clips(Scene *s)
+{
+    Lights *L = &s->lights;
+    int l, j, spheres = 0;
+    free(L->clip);
+    L->clip = NULL, L->nclip = 0;
+    for (l = 0; l < L->nemit; l++) spheres += L->emit[l].type == SPHERE_LIGHT;
+    if (!spheres || s->set.no_skip || (double)spheres * s->nsph > CLIP_PAIRS) return;
+    L->clip = malloc((size_t)spheres * MAX_CLIPS * sizeof *L->clip);
+    if (!L->clip) out_of_memory();
+    for (l = 0; l < L->nemit; l++) {
+        Emitter *e = &L->emit[l];
+        const Sphere *sp = &s->sph[e->obj];     /* spheres are the first objects */
+        e->clip = L->nclip, e->nclips = 0;
+        if (e->type != SPHERE_LIGHT || moves(s, e->obj)) continue;
+        for (j = 0; j < s->nsph; j++) {
+            const Sphere *o = &s->sph[j];
+            vec a = sub(o->cen, sp->cen);
+            real d = sqrt(dot(a, a)), R = sp->rad, rho = o->rad, margin;
+            Clip c;
+            if (j == e->obj || moves(s, j) || s->mat[o->mat].kt > 0) continue;
+            if (!(d < R + rho) || !(d > fabs(R - rho))) continue;       /* the surfaces do not cross */
+            margin = 64 * REAL_EPS * (R + d + rho) * (R + d + rho) / (2 * R * d);
+            c.obj = j;
+            c.axis = scale(1 / d, a);
+            c.in = (rho - d + R) * (rho + d - R) / (2 * R * d) + margin;
+            c.out = (R + d - rho) * (R + d + rho) / (2 * R * d) + margin;
+            if (e->nclips < MAX_CLIPS) L->clip[e->clip + e->nclips++] = c;
+            else {
+                Clip *widest = widest_clip(L, e);
+                if (clip_size(&c) < clip_size(widest)) *widest = c;
+            }
+        }
+        L->nclip += e->nclips;
+    }
+}
+
+/* How many glowing spheres have clips (for --stats). */
+static int clipped_lights(const Scene *s)
+{
+    int l, n = 0;
+    for (l = 0; l < s->lights.nemit; l++) n += s->lights.emit[l].nclips > 0;
+    return n;
+}
+
+/* The cap of glowing sphere l that holds every point of it x can see, when
+ * a clip makes it smaller than what sphere_sample spreads its points over
+ * (the part of the sphere that faces x, or from inside the whole sphere):
+ * its axis and its height, as sphere_cap takes it.  Returns 0 when no clip
+ * does.  Which of a clip's two caps x may see follows the side of the clip
+ * x is on; a point on the clip's surface (within its rounding) sees the
+ * side its normal n faces.  Sampling only the cap costs no bias, since the
+ * rest could not be seen, and on smallpt's scene, where the ceiling hides
+ * all but a disc 36 across of a lamp 1200 across, it turns shadow rays
+ * that almost all met the ceiling into rays that almost all reach the
+ * lamp. */
+static int visible_cap(const Scene *s, int l, vec x, vec n, vec *axis, real *cap)
+{
+    const Emitter *e = &s->lights.emit[l];
+    const Sphere *sp = &s->sph[e->obj];
+    vec dx = sub(x, sp->cen);
+    real d2 = dot(dx, dx), best;
+    int i, found = 0;
+    if (e->type != SPHERE_LIGHT || e->nclips == 0) return 0;
+    best = d2 > sp->rad * sp->rad * (1 + 64 * REAL_EPS) ? 1 - sp->rad / sqrt(d2) : 2;
+    for (i = e->clip; i < e->clip + e->nclips; i++) {
+        const Clip *c = &s->lights.clip[i];
+        const Sphere *o = &s->sph[c->obj];
+        vec dq = sub(x, o->cen);
+        real out = dot(dq, dq) - o->rad * o->rad;          /* > 0 outside, about 2 rho times the distance */
+        real band = 2048 * REAL_EPS * o->rad * (o->rad + maxabs(o->cen) + maxabs(x));
+        int inside = fabs(out) <= band ? dot(n, dq) < 0 : out < 0;
+        real h = inside ? c->in : c->out;
+        if (h < best) best = *cap = h, *axis = inside ? c->axis : scale(-1, c->axis), found = 1;
+    }
+    return found;
 }
 
 /* The light tree over lights order[0..n-1] below the given parent: its
@@ -3141,7 +3261,10 @@ static int sample_emitter(const Scene *s, int l, vec x, vec n, real time, real u
     kind(s, e->obj, &k);
     x = rest_frame(s, e->obj, time, x);
     if (e->type == SPHERE_LIGHT) {
-        *pdf = sphere_sample(&s->sph[k], x, u, v, wi, dist);
+        vec axis;
+        real cap;
+        *pdf = visible_cap(s, l, x, n, &axis, &cap) ? cap_sample(&s->sph[k], axis, cap, x, u, v, wi, dist)
+                                                    : sphere_sample(&s->sph[k], x, u, v, wi, dist);
         m = &s->mat[s->sph[k].mat];
     } else {
         real area = triangle_light_sample(&s->tri[k], x, u, v, &y, &ny);   /* its solid angle, or 0 */
@@ -3169,7 +3292,12 @@ static real light_pdf(const Scene *s, int l, vec x, vec n, vec y, vec ny, real t
     kind(s, e->obj, &k);
     x = rest_frame(s, e->obj, time, x);
     y = rest_frame(s, e->obj, time, y);
-    if (e->type == SPHERE_LIGHT) return chance * sphere_pdf(&s->sph[k], x, y);
+    if (e->type == SPHERE_LIGHT) {
+        vec axis;
+        real cap;
+        return chance * (visible_cap(s, l, x, n, &axis, &cap) ? cap_pdf(&s->sph[k], axis, cap, x, y)
+                                                              : sphere_pdf(&s->sph[k], x, y));
+    }
     d = sub(y, x);
     dist = sqrt(dot(d, d));
     return chance * triangle_light_pdf(&s->tri[k], x, dist, dot(d, ny) / dist);
@@ -3712,6 +3840,12 @@ static int prim_clip(void *user, int i, const double blo[3], const double bhi[3]
  * (5 spheres) the loop is 25% faster. */
 #define TREE_FROM 8
 
+/* Up to this many objects auto also times the loop against the trees: where
+ * most objects are large (smallpt's walls are spheres of radius 1e5, each
+ * box holding the whole room), every tree tests nearly every object anyway
+ * and the loop is quicker. */
+#define LOOP_TRIAL 64
+
 /* Whether every object lies within the range the structures' float boxes
  * and planes can hold (they clamp beyond FLT_MAX), with float precision to
  * spare: coordinates below 1e37, and a scene that reaches beyond 1e-30
@@ -3771,13 +3905,18 @@ static int build_one(Scene *s, int which)
  * the BVH (SPD scenes and a 100k-triangle sphere), so it is tried only when
  * 8 times the BVH's build is under a twentieth of the BVH's estimate: the
  * trial then costs at most 5%, and the kd-tree has room to win back its
- * build.  The probe itself costs 1/256 of a 512x512 image per structure. */
+ * build.  The probe itself costs 1/256 of a 512x512 image per structure.
+ * Below LOOP_TRIAL objects the loop over them all takes the first turn. */
 #define KD_BUILD_RATIO 8.0
 static int choose_accel(Scene *s)
 {
     static const int which[3] = { ACCEL_BVH, ACCEL_GRID, ACCEL_KD };
     double best = HUGE_VAL, cost, built = 0, scale = (double)s->set.w * s->set.h / (PROBE * PROBE);
     int k, pick = 0;
+    if (nobj(s) < LOOP_TRIAL && !s->set.no_skip) {
+        s->accel.which = ACCEL_NONE;
+        best = scale * probe(s, HUGE_VAL), pick = -1;
+    }
     for (k = 0; k < 3; k++) {
         clock_t start = clock();
         if (which[k] == ACCEL_KD && KD_BUILD_RATIO * built > 0.05 * best) break;
@@ -3793,14 +3932,15 @@ static int choose_accel(Scene *s)
         if (which[k] == ACCEL_BVH) bvh_free(s->accel.bvh), s->accel.bvh = NULL;
         if (which[k] == ACCEL_GRID) grid_free(s->accel.grid), s->accel.grid = NULL;
     }
-    s->accel.which = which[pick];
+    s->accel.which = pick < 0 ? ACCEL_NONE : which[pick];
     return 1;
 }
 
 /* The structure that answers nearest_hit and any_hit, as --accel says: the
  * kd-tree, the BVH (its SAH build), the grid, none (every ray tests every
  * object), or auto: none below TREE_FROM objects, else the one that
- * choose_accel measures fastest on this scene. */
+ * choose_accel measures fastest on this scene (the loop too, below
+ * LOOP_TRIAL). */
 static int build_accel(Scene *s, const char *accel)
 {
     int ok;
@@ -3982,6 +4122,31 @@ static real sphere_pdf(const Sphere *sp, vec x, vec y)
         return sphere_cap_pdf(r2 / d2 / (1 + sqrt(1 - r2 / d2)));
     cosy = fabs(dot(sub(y, sp->cen), d)) / (sp->rad * sqrt(dist2));
     return dist2 / (4 * (real)PI * r2 * cosy);
+}
+
+/* A uniform point of the cap of sphere sp about the unit axis, of height
+ * cap (sphere_cap's), seen from x: wi towards it, its distance, and the
+ * pdf of wi in solid angle, the cap's area turned into solid angle as from
+ * inside in sphere_sample.  A light's clip gives the cap (visible_cap). */
+static real cap_sample(const Sphere *sp, vec axis, real cap, vec x, real u, real v, vec *wi, real *dist)
+{
+    vec y = comb(sp->rad, from_local(axis, sphere_cap(cap, u, v)), sp->cen), d = sub(y, x);
+    *dist = sqrt(dot(d, d));
+    *wi = scale(1 / *dist, d);
+    return cap_pdf(sp, axis, cap, x, y);
+}
+
+/* The pdf with which cap_sample, from x, picks the direction to y, a point
+ * of the sphere: 0 off the cap, and 0 where y faces away from an x outside
+ * the sphere (the sphere itself hides it). */
+static real cap_pdf(const Sphere *sp, vec axis, real cap, vec x, vec y)
+{
+    vec u = scale(1 / sp->rad, sub(y, sp->cen)), d = sub(x, y), dc = sub(x, sp->cen);
+    real dist2 = dot(d, d), cosy = dot(u, d) / sqrt(dist2);
+    if (dot(u, axis) < 1 - cap) return 0;
+    if (dot(dc, dc) <= sp->rad * sp->rad * (1 + 64 * REAL_EPS)) cosy = fabs(cosy);   /* from inside */
+    if (!(cosy > 0)) return 0;
+    return dist2 / (2 * (real)PI * sp->rad * sp->rad * cap * cosy);
 }
 
 /* --------------------------------------------------- the primitives: cones */
@@ -5139,6 +5304,7 @@ static void report_stats(const Scene *s, const Counts *c, int spp, int kv, doubl
     st.discarded = c->discarded, st.queries = c->queries, st.nearest = c->nearest;
     st.hits = c->hits, st.tests = c->tests, st.steps = c->steps;
     st.no_skip = s->set.no_skip, st.behind = c->behind, st.faint = c->faint, st.dim = c->dim;
+    st.clipped = clipped_lights(s);
     st.adaptive = s->set.adaptive, st.samples = c->samples, st.spp_min = c->spp_min, st.spp_max = c->spp_max;
     st.load = load, st.build = build, st.seconds = seconds, st.cpu = cpu;
     print_stats(stderr, &st, kv);
@@ -5152,6 +5318,7 @@ static void free_scene(Scene *s)
     free(s->mat); free(s->sph); free(s->cone); free(s->tri);
     free(s->vert); free(s->norm); free(s->light);
     free(s->lights.emit); free(s->lights.node); free(s->lights.leaf); free(s->lights.emitter);
+    free(s->lights.clip);
 }
 
 /* Why the picture will come out black, or NULL: nothing lights the

@@ -4,7 +4,9 @@
  *     cc -std=c99 -O2 -o pfmerr bench/pfmerr.c -lm
  *     ./pfmerr IMAGE.pfm REFERENCE.pfm [NORMALS.pfm]
  *
- * Prints one line, "rmse=R lit_rmse=L display_rmse=D pixels=N", and with
+ * Either file may also be a plain PPM (P3, as smallpt writes it: bytes of
+ * the linear value to the power 1/2.2), read back to linear values.
+ * Prints one line, "rmse=R lit_rmse=L display_rmse=D clamped_rmse=C pixels=N", and with
  * NORMALS (./ray --view normal of the same scene and size) " floor_rmse=F
  * floor_pixels=M" after it:
  *   rmse          root mean square difference of the linear values, every
@@ -15,6 +17,8 @@
  *                 the pixel (the same for every estimator) dominates
  *   display_rmse  of the images as shown: clamped to 0..1 and through the
  *                 sRGB curve, in 8-bit levels
+ *   clamped_rmse  of the linear values clamped to 0..1, as smallpt clamps
+ *                 them: of two seeds' images, over sqrt 2, their noise
  *   floor_rmse    rmse over the pixels whose first hit faces straight up
  *                 (y up: --view normal's 0.5 + n / 2 is (0.5, 1, 0.5)): the
  *                 floor seen directly, where the caustic's light lands, and
@@ -40,6 +44,17 @@ static int load(const char *name, pfm *img)
     size_t n, i;
     unsigned char b[4];
     if (!f) { fprintf(stderr, "pfmerr: cannot open %s\n", name); return 0; }
+    if (fscanf(f, "P3 %d %d %lf", &img->w, &img->h, &scale) == 3) {    /* smallpt's plain PPM */
+        int v;
+        n = img->w > 0 && img->h > 0 && img->w <= 32768 && img->h <= 32768 ? (size_t)img->w * img->h * 3 : 0;
+        img->px = n ? malloc(n * sizeof *img->px) : NULL;
+        for (i = 0; img->px && scale > 0 && i < n && fscanf(f, "%d", &v) == 1; i++)
+            img->px[i] = (float)pow(v / scale, 2.2);
+        fclose(f);
+        if (!img->px || i < n) { fprintf(stderr, "pfmerr: %s is not a whole P3 PPM\n", name); return 0; }
+        return 1;
+    }
+    rewind(f);
     if (fscanf(f, "%2s %d %d %lf", magic, &img->w, &img->h, &scale) != 4 || strcmp(magic, "PF")
         || img->w < 1 || img->h < 1 || img->w > 32768 || img->h > 32768 || scale == 0
         || fgetc(f) == EOF) {
@@ -71,7 +86,7 @@ static double shown(double v)
 int main(int argc, char **argv)
 {
     pfm a, r, nm;
-    double sum = 0, lit = 0, disp = 0, floor = 0;
+    double sum = 0, lit = 0, disp = 0, floor = 0, clamped = 0;
     long nlit = 0, nfloor = 0, k, n;
     if (argc != 3 && argc != 4) { fprintf(stderr, "usage: pfmerr IMAGE.pfm REFERENCE.pfm [NORMALS.pfm]\n"); return 2; }
     if (!load(argv[1], &a) || !load(argv[2], &r) || (argc == 4 && !load(argv[3], &nm))) return 2;
@@ -87,7 +102,9 @@ int main(int argc, char **argv)
                  && fabs(nm.px[3 * k + 2] - 0.5) < 1e-4;
         for (c = 0; c < 3; c++) {
             double d = (double)p[c] - q[c], e = shown(p[c]) - shown(q[c]);
+            double g = fmin(1, fmax(0, p[c])) - fmin(1, fmax(0, q[c]));
             sum += d * d;
+            clamped += g * g;
             disp += e * e;
             if (!bright) lit += d * d;
             if (up) floor += d * d;
@@ -95,8 +112,8 @@ int main(int argc, char **argv)
         nlit += !bright;
         nfloor += up;
     }
-    printf("rmse=%.6g lit_rmse=%.6g display_rmse=%.4g pixels=%ld", sqrt(sum / (3.0 * n)),
-           nlit ? sqrt(lit / (3.0 * nlit)) : 0.0, sqrt(disp / (3.0 * n)), n);
+    printf("rmse=%.6g lit_rmse=%.6g display_rmse=%.4g clamped_rmse=%.6g pixels=%ld", sqrt(sum / (3.0 * n)),
+           nlit ? sqrt(lit / (3.0 * nlit)) : 0.0, sqrt(disp / (3.0 * n)), sqrt(clamped / (3.0 * n)), n);
     if (argc == 4) printf(" floor_rmse=%.6g floor_pixels=%ld", nfloor ? sqrt(floor / (3.0 * nfloor)) : 0.0, nfloor);
     printf("\n");
     return 0;

@@ -26,6 +26,15 @@
 #     than smallpt (Beason 2008) built with g++ -O3, one thread, 1024x768 at
 #     4 samples a pixel both; smallpt is not part of this project: set
 #     BENCH_SMALLPT=path/to/smallpt.cpp (the 99-line original) to run it;
+#   - smallpt's scene, 256x192: at smallpt's CPU time for 64 spp, the noise
+#     of our default (MIS) at most half of smallpt's; the noise of each is
+#     the RMSE between the images of two seeds, over sqrt 2, of the linear
+#     values clamped to 0..1 as smallpt clamps them (bench/pfmerr.c's
+#     clamped_rmse; smallpt's P3 read back through its 1/2.2 power).  Ours
+#     runs at BENCH_SMALLPT_SPP (32) and its noise is taken to smallpt's
+#     time as noise^2 x time is constant for an unbiased estimator.  smallpt
+#     is built from BENCH_SMALLPT with its size and seed set by sed (the
+#     lines it changes are named below; another source is not run);
 #   - rays per second of the path tracer (MIS) within 10% of the Whitted
 #     renderer's on the same scene (smallpt's), one thread;
 #   - the caustic: BDPT or progressive photon mapping reaches the RMSE of
@@ -41,7 +50,7 @@
 # Knobs: BENCH_PT_REF_SPP (4096), BENCH_PT_SPP ("1 4 16 64 256"), BENCH_PT_TOP (1024: the
 #        caustic's MIS and BDPT run there too),
 #        BENCH_PT_SCENES ("cornell:128x128 smallpt:128x96 caustic:160x120"), BENCH_SMALLPT,
-#        BENCH_PT_ROUNDS (BENCH_ROUNDS, else 3).
+#        BENCH_SMALLPT_SPP, BENCH_PT_ROUNDS (BENCH_ROUNDS, else 3).
 set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
@@ -246,6 +255,38 @@ else
   cpu "$RAY" --pt -t 1 --estimator bsdf -s 1024x768 -n 4 -o "$OUT/pt-ours-smallpt.pfm" scenes/smallpt.sph || die "ray failed"
   us_o=$(table us-per "$cpu" $((1024 * 768 * 4)) %.3f)
   echo "smallpt's scene 1024x768 at 4 spp, one thread: ours (BSDF sampling) $us_o us of CPU a sample; smallpt not run (set BENCH_SMALLPT=path/to/smallpt.cpp)" >>"$OUT/pt-targets.txt"
+fi
+
+# Target 4: noise at equal CPU time against smallpt at 64 spp, 256x192:
+# smallpt's size and seed made settable (its `int w=1024, h=768` and the
+# seed {0,0,y*y*y} of each row), two seeds each, the CPU times of the
+# first seed's runs taking turns in $ROUNDS rounds.
+SP_SPP=${BENCH_SMALLPT_SPP:-32}
+if [ -x "$OUT/smallpt" ] && grep -q 'int w=1024, h=768' "$SMALLPT" && grep -q 'Xi\[3\]={0,0,y\*y\*y}' "$SMALLPT" &&
+   sed 's/int w=1024, h=768/int w=256, h=192/; s/Xi\[3\]={0,0,y\*y\*y}/Xi[3]={SEED,0,(unsigned short)(y*y*y)}/' "$SMALLPT" >"$OUT/smallpt-seeded.cpp" &&
+   g++ -O3 -w -DSEED=1 -o "$OUT/smallpt1" "$OUT/smallpt-seeded.cpp" && g++ -O3 -w -DSEED=2 -o "$OUT/smallpt2" "$OUT/smallpt-seeded.cpp"; then
+  ours='' sp=''
+  for ((round = 1; round <= ROUNDS; round++)); do
+    cpu "$RAY" -t 1 -s 256x192 -n "$SP_SPP" --seed 1 -o "$OUT/pt-noise1.pfm" scenes/smallpt.sph || die "ray failed"
+    ours+="$cpu "
+    cpu bash -c "cd $OUT && OMP_NUM_THREADS=1 exec ./smallpt1 64" || die "smallpt failed"
+    sp+="$cpu "
+    mv "$OUT/image.ppm" "$OUT/smallpt1.ppm"
+  done
+  "$RAY" -t 1 -s 256x192 -n "$SP_SPP" --seed 2 -o "$OUT/pt-noise2.pfm" scenes/smallpt.sph 2>/dev/null || die "ray failed"
+  (cd "$OUT" && OMP_NUM_THREADS=1 ./smallpt2 64 2>/dev/null && mv image.ppm smallpt2.ppm) || die "smallpt failed"
+  n_o=$("$OUT/pfmerr" "$OUT/pt-noise1.pfm" "$OUT/pt-noise2.pfm" | sed 's/.*clamped_rmse=\([^ ]*\).*/\1/')
+  n_s=$("$OUT/pfmerr" "$OUT/smallpt1.ppm" "$OUT/smallpt2.ppm" | sed 's/.*clamped_rmse=\([^ ]*\).*/\1/')
+  # shellcheck disable=SC2086
+  t_o=$(median $ours) t_s=$(median $sp)
+  eq=$(awk -v n="$n_o" -v a="$t_o" -v b="$t_s" 'BEGIN { printf "%.4f", n / sqrt(2) * sqrt(a / b) }')
+  r=$(awk -v e="$eq" -v n="$n_s" 'BEGIN { printf "%.2f", e / (n / sqrt(2)) }')
+  q=$(ratios "$ours" "$sp")
+  v=$(verdict "$r" "<=" 0.5)
+  # shellcheck disable=SC2086
+  echo "smallpt's scene 256x192, one thread: smallpt at 64 spp $t_s s CPU ($(range %.2f $sp)), noise $(awk -v n="$n_s" 'BEGIN { printf "%.4f", n / sqrt(2) }'); ours (MIS) at $SP_SPP spp $t_o s ($(range %.2f $ours); time ratios $(range %.2f $q)), noise $(awk -v n="$n_o" 'BEGIN { printf "%.4f", n / sqrt(2) }'), at smallpt's time $eq: ratio $r (target <= 0.5): $v" >>"$OUT/pt-targets.txt"
+else
+  echo "smallpt's scene: the noise at equal time against smallpt not measured (set BENCH_SMALLPT to smallpt's 99-line source, which g++ builds)" >>"$OUT/pt-targets.txt"
 fi
 
 # Target 3: rays per second, path tracing (MIS) against Whitted, smallpt's

@@ -38,7 +38,8 @@ Whitted adaptive AA|scenes/whitted.sph|320x240|-n 64 --adaptive 2||4 8 16 32 64
 light tree (--light-choice)|scenes/lights100.sph|320x240|-n 16|--light-choice power|16 32 64 128 256
 Sobol' samples (--sampler)|scenes/cornell.sph|128x128|-n 64 --sampler sobol|--sampler independent|64 128 256
 Russian roulette|scenes/cornell.sph|128x128|-d 16 -n 64|-d 16 --no-roulette|32 64 128 256
-path tracer adaptive|scenes/cornell.sph|128x128|-n 256 --adaptive 4||64 128 256"}
+path tracer adaptive|scenes/cornell.sph|128x128|-n 256 --adaptive 4||64 128 256
+the lamp in its cap, the loop (--no-skip)|scenes/smallpt.sph|128x96|-n 64|--no-skip|64 128 256 512"}
 LOG=skips
 . bench/lib.sh
 build_time_tools || die "cannot build ray, pfmerr, svgplot or table"

@@ -60,6 +60,9 @@ fi
 # larger on 12 of the 15 scenes (balls: 2.93 -> 26.1, and its steps a ray
 # 6.9 -> 38.4), though it finds the same hits.  A better structure may
 # lower the bounds; raise one only for a reason, said in the commit.
+# (smallpt.sph's tests and steps a ray rose, the same structures, when its
+# lamp came to be sampled in the cap the ceiling leaves seen: shadow rays
+# that stopped at the ceiling near their start now cross the room.)
 # work ACCEL NAME FIRST < TABLE: one line a scene of TABLE, `scene | args |
 # bounds: FIRST, tests, steps | today's`, FIRST the figure --stats gives
 # before "references per object" or after "SAH cost".
@@ -100,7 +103,7 @@ minray.sph   | -s 48x48        | 3.0   3.4   4.0  | 2.66  3.07  3.58
 mesh.sph     | -s 48x48        | 7.0   4.1   6.9  | 6.31  3.68  6.27
 demo.nff     | -s 48x48        | 5.1   4.4   3.7  | 4.58  3.92  3.28
 cornell.sph  | -s 24x24 -n 1   | 14.7  10.2  9.8  | 13.36 9.26  8.89
-smallpt.sph  | -s 24x24 -n 1   | 6.0   7.4   0.9  | 5.40  6.68  0.73
+smallpt.sph  | -s 24x24 -n 1   | 6.0   9.5   1.1  | 5.40  8.66  0.99
 caustic.sph  | -s 24x24 -n 1   | 4.0   5.8   1.1  | 3.60  5.23  0.98
 bleed.sph    | -s 24x24 -n 1   | 3.8   2.8   5.8  | 3.45  2.51  5.22
 BOUNDS
@@ -119,7 +122,7 @@ minray.sph   | -s 48x48        | 2.4   1.6   2.6   | 2.18  1.43  2.34
 mesh.sph     | -s 48x48        | 3.4   2.2   3.4   | 3.06  1.98  3.09
 demo.nff     | -s 48x48        | 3.4   1.5   2.8   | 3.02  1.30  2.46
 cornell.sph  | -s 24x24 -n 1   | 9.4   3.9   6.6   | 8.52  3.46  5.98
-smallpt.sph  | -s 24x24 -n 1   | 3.7   6.2   7.5   | 3.29  5.58  6.77
+smallpt.sph  | -s 24x24 -n 1   | 3.7   8.2   10.6  | 3.29  7.39  9.57
 caustic.sph  | -s 24x24 -n 1   | 2.9   2.2   2.8   | 2.61  1.96  2.48
 bleed.sph    | -s 24x24 -n 1   | 3.2   1.6   2.6   | 2.90  1.45  2.36
 BOUNDS
@@ -138,7 +141,7 @@ minray.sph   | -s 48x48        | 4.4   5.0   1.4   | 4.00  4.48  1.19
 mesh.sph     | -s 48x48        | 3.9   13.7  4.7   | 3.52  12.45 4.23
 demo.nff     | -s 48x48        | 5.0   3.5   1.9   | 4.50  3.18  1.64
 cornell.sph  | -s 24x24 -n 1   | 7.6   10.4  3.9   | 6.82  9.39  3.46
-smallpt.sph  | -s 24x24 -n 1   | 13.6  7.4   0.9   | 12.33 6.70  0.73
+smallpt.sph  | -s 24x24 -n 1   | 13.6  9.5   1.1   | 12.33 8.66  0.99
 caustic.sph  | -s 24x24 -n 1   | 4.6   5.4   2.1   | 4.17  4.90  1.90
 bleed.sph    | -s 24x24 -n 1   | 10.7  9.8   1.7   | 9.67  8.90  1.51
 BOUNDS

@@ -20,11 +20,14 @@ for c in importance power; do
     ./ray scenes/lights100.sph -s 64x48 -n 16 --light-choice $c --seed $seed -o "$TMP/$c$seed.pfm" 2>/dev/null
   done
 done
-z=$(python3 -c "$PFM_PY
+mean_apart() {   # image $2 minus image $1, per pixel: its mean in standard errors
+  python3 -c "$PFM_PY
 a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
 d = [sum(b[3 * k:3 * k + 3]) - sum(a[3 * k:3 * k + 3]) for k in range(len(a) // 3)]
 n = len(d); m = sum(d) / n; v = sum((x - m) ** 2 for x in d) / (n - 1)
-print('%.2f' % (m / (v / n) ** 0.5 if v > 0 else 99))" "$TMP/power1.pfm" "$TMP/importance2.pfm")
+print('%.2f' % (m / (v / n) ** 0.5 if v > 0 else 99))" "$1" "$2"
+}
+z=$(mean_apart "$TMP/power1.pfm" "$TMP/importance2.pfm")
 awk -v z="$z" 'BEGIN { exit !(z != "" && z < 4 && z > -4) }' \
   && ok "lights100.sph: --light-choice importance's image has power's mean (difference $z standard errors over 3072 pixels)" \
   || bad "lights100.sph: --light-choice importance's mean differs from power's by '$z' standard errors"
@@ -40,3 +43,35 @@ ni=$(noise importance power) np=$(noise power importance)
 awk -v i="$ni" -v p="$np" 'BEGIN { exit !(p > 0 && i <= 0.5 * p) }' \
   && ok "lights100.sph at 16 spp: --light-choice importance's noise $ni, power's $np ($(awk -v i="$ni" -v p="$np" 'BEGIN { printf "%.2f", i / p }') of it; at most 0.5)" \
   || bad "lights100.sph at 16 spp: --light-choice importance's noise '$ni' against power's '$np' (want at most 0.5 of it)"
+
+# Glowing spheres cut by opaque ones (tests/test_light.c, then images):
+# sampling only the cap a point can see changes the noise, never the mean.
+# On smallpt's scene (its lamp sunk into the ceiling but for a disc) and on
+# clips.sph (written by test_light: lamps sunk into a floor and into balls,
+# seen from outside them), the default against --no-skip (which samples the
+# whole lamp) averages 0 over the image within 4 standard errors; and on
+# smallpt's room without its two balls (whose caustics, which no light
+# sample finds, are most of the noise where they stand) the noise (RMSE
+# between two seeds over sqrt 2) falls to at most 0.4 of --no-skip's.
+grep -v '^27 \|^73 ' scenes/smallpt.sph >"$TMP/room.sph"
+for f in scenes/smallpt.sph "$TMP/clips.sph" "$TMP/room.sph"; do
+  for seed in 1 2; do
+    ./ray "$f" -s 32x24 -n 64 --seed $seed -o "$TMP/clip$seed.pfm" 2>/dev/null
+    ./ray "$f" -s 32x24 -n 64 --seed $seed --no-skip -o "$TMP/whole$seed.pfm" 2>/dev/null
+  done
+  z=$(mean_apart "$TMP/whole1.pfm" "$TMP/clip2.pfm")
+  awk -v z="$z" 'BEGIN { exit !(z != "" && z < 4 && z > -4) }' \
+    && ok "${f##*/}: the lamps sampled in their caps give --no-skip's mean (difference $z standard errors over 768 pixels)" \
+    || bad "${f##*/}: the lamps sampled in their caps differ from --no-skip's mean by '$z' standard errors"
+  if [ "$f" = "$TMP/room.sph" ]; then
+    seeds_apart() {   # the noise of two seeds' images: their RMSE over sqrt 2
+      python3 -c "$PFM_PY
+a, b = pfm(sys.argv[1]), pfm(sys.argv[2])
+print('%.5f' % ((sum((x - y) ** 2 for x, y in zip(a, b)) / len(a) / 2) ** 0.5))" "$1" "$2"
+    }
+    nc=$(seeds_apart "$TMP/clip1.pfm" "$TMP/clip2.pfm") nw=$(seeds_apart "$TMP/whole1.pfm" "$TMP/whole2.pfm")
+    awk -v c="$nc" -v w="$nw" 'BEGIN { exit !(w > 0 && c <= 0.4 * w) }' \
+      && ok "smallpt's room without its balls at 64 spp: the lamp sampled in its cap, noise $nc against --no-skip's $nw ($(awk -v c="$nc" -v w="$nw" 'BEGIN { printf "%.2f", c / w }') of it; at most 0.4)" \
+      || bad "smallpt's room without its balls at 64 spp: the lamp sampled in its cap, noise '$nc' against --no-skip's '$nw' (want at most 0.4 of it)"
+  fi
+done

@@ -36,7 +36,8 @@
 #            against brute force; photon mapping's bias, progressive photon
 #            mapping's, --view photons)
 #     light  tests/light.test.sh (tests/test_light.c: Arvo's sampler and the
-#            light tree; the light choice's images)
+#            light tree; glowing spheres sampled in their clips' caps; the light
+#            choice's and the caps' images)
 #     kdbuild  tests/kdbuild.test.sh (the kd build's budget on fans, the
 #            ear clipper, what kdtree.c and bvh.c hold at their peaks)
 #
