@@ -75,3 +75,29 @@ print('%.5f' % ((sum((x - y) ** 2 for x, y in zip(a, b)) / len(a) / 2) ** 0.5))"
       || bad "smallpt's room without its balls at 64 spp: the lamp sampled in its cap, noise '$nc' against --no-skip's '$nw' (want at most 0.4 of it)"
   fi
 done
+
+# A furnace of two glowing spheres that cut each other, both of albedo .5
+# and Le 1.5, the camera in the lens they share: every surface it can see
+# is the inside of one of them within the other, each sampled in the cap
+# the other leaves seen, so L = Le (1 - a^N) / (1 - a) with -d N, and
+# Le / (1 - a) unbounded, within 4 standard errors: with MIS, and with
+# next-event estimation alone, whose lamps are found by light samples only
+# (MIS would stay unbiased with a cap that misses what a point sees, its
+# BSDF samples then weighed 1 there).
+printf 'integrator path\ncamera .75 -.5 0   .75 1 0   0 0 1   90\n0 0 0  1 1 1  2  .5 0 0 1.5 1\n1.5 0 0  1 1 1  2  .5 0 0 1.5 1\n' >"$TMP/lens.sph"
+[ "$(./ray --stats=kv -s 4x4 -n 1 -o "$TMP/l.pfm" "$TMP/lens.sph" 2>&1 | awk '$1 == "clipped_lights" { print $2 }')" = 2 ] \
+  && ok "lens.sph: both glowing spheres clipped (--stats=kv clipped_lights 2)" \
+  || bad "lens.sph: --stats=kv does not count both glowing spheres clipped"
+for r in "4 2.8125 mis" "0 3 mis" "4 2.8125 nee" "0 3 nee"; do
+  set -- $r
+  d=""; [ "$1" != 0 ] && d="-d $1"
+  # shellcheck disable=SC2086
+  ./ray "$TMP/lens.sph" -s 32x32 -n 32 $d --estimator $3 -o "$TMP/l.pfm" 2>/dev/null
+  read -r mean z <<<"$(python3 -c "$PFM_PY
+a = pfm(sys.argv[1]); d = [sum(a[3 * k:3 * k + 3]) / 3 for k in range(len(a) // 3)]
+n = len(d); m = sum(d) / n; v = sum((x - m) ** 2 for x in d) / (n - 1)
+print('%.4f %.2f' % (m, (m - float(sys.argv[2])) / (v / n) ** 0.5 if v > 0 else (0 if m == float(sys.argv[2]) else 99)))" "$TMP/l.pfm" "$2")"
+  awk -v z="$z" 'BEGIN { exit !(z != "" && z < 4 && z > -4) }' \
+    && ok "two glowing spheres that cut each other, a furnace${d:+ at $d}, $3: mean $mean is $2 within $z standard errors" \
+    || bad "two glowing spheres that cut each other, a furnace${d:+ at $d}, $3: mean '$mean' is not $2: '$z' standard errors"
+done
