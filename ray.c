@@ -2931,16 +2931,24 @@ static void prepare_lights(Scene *s)
 /* The clips of each glowing sphere at rest: the opaque spheres at rest
  * whose surfaces cross its own.  A few a light are enough, since each alone
  * bounds what a point can see: those with the smallest caps are kept (a
- * wall may cut off half the lamp, and the ceiling all but a disc); and
- * where lights times spheres are too many to pair up, or with --no-skip,
- * none are looked for (the lights are then sampled whole: more shadow rays
- * blocked, the same mean).  Each cap's
- * height, from the lecture's cosine rule (d^2 = R^2 + rho^2 - 2 R rho cos)
- * written as products that do not cancel, is grown by a bound on its
- * rounding, so that no point a ray can meet falls outside it. */
+ * wall may cut off half the lamp, and the ceiling all but a disc), smallest
+ * first, so that visible_cap stops at the first that cannot beat what it
+ * has; and where lights times spheres are too many to pair up, or with
+ * --no-skip, none are looked for (the lights are then sampled whole: more
+ * shadow rays blocked, the same mean).  Each cap's height, from the
+ * lecture's cosine rule (d^2 = R^2 + rho^2 - 2 R rho cos) written as
+ * products that do not cancel, is grown by a bound on its rounding, so
+ * that no point a ray can meet falls outside it. */
 #define MAX_CLIPS 4
 #define CLIP_PAIRS 20000000.0
 static real clip_size(const Clip *c) { return fmin(c->in, c->out); }
+
+/* qsort's order of clips: by the smaller of their caps, smallest first. */
+static int by_clip_size(const void *a, const void *b)
+{
+    real x = clip_size(a), y = clip_size(b);
+    return (x > y) - (x < y);
+}
 
 /* Of light e's clips, the one whose smaller cap is the largest. */
 static Clip *widest_clip(Lights *L, const Emitter *e)
@@ -2985,6 +2993,7 @@ static void find_clips(Scene *s)
                 if (clip_size(&c) < clip_size(widest)) *widest = c;
             }
         }
+        qsort(&L->clip[e->clip], (size_t)e->nclips, sizeof *L->clip, by_clip_size);
         L->nclip += e->nclips;
     }
 }
@@ -3020,6 +3029,7 @@ static int visible_cap(const Scene *s, int l, vec x, vec n, vec *axis, real *cap
     for (i = e->clip; i < e->clip + e->nclips; i++) {
         const Clip *c = &s->lights.clip[i];
         const Sphere *o = &s->sph[c->obj];
+        if (clip_size(c) >= best) break;            /* neither cap smaller; nor any after it */
         vec dq = sub(x, o->cen);
         real out = dot(dq, dq) - o->rad * o->rad;          /* > 0 outside, about 2 rho times the distance */
         real band = 2048 * REAL_EPS * o->rad * (o->rad + maxabs(o->cen) + maxabs(x));
