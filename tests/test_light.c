@@ -463,6 +463,62 @@ static void test_cap_integral(void)
     free_scene(&s);
 }
 
+/* cap_sample against cap_pdf, Nori's pairing of a warp with its pdf: from
+ * points below smallpt's lamp and beside it, the directions it gives are
+ * counted in 8 x 8 cells of the cap (by height and angle about its axis),
+ * against each cell's share by cap_pdf integrated over the directions to
+ * it (a 16 x 16 midpoint rule in each cell: dw = cos_y dA / d^2); chi-square
+ * of 63 degrees of freedom, whose 99.9th percentile is 103.4. */
+static void test_cap_chi_square(void)
+{
+    Scene s;
+    unsigned long long x = 23;
+    double worst = 0;
+    int k, j, a, b, N = 8, M = 16, m = 64000;
+    if (!load_scene(&s, "scenes/smallpt.sph") || !settle_path_options(&s, PATH, -1, 1, 0)) {
+        report(0, "clipped lamps: cap_sample against cap_pdf", "scenes/smallpt.sph did not load");
+        return;
+    }
+    for (k = 0; k < 3; k++) {
+        const Sphere *sp = &s.sph[s.lights.emit[0].obj];
+        vec p = k == 0 ? v3(50, 0, 81.6) : k == 1 ? v3(5, 40, 150) : v3(90, 75, 20), n = v3(0, 1, 0), axis, wi, t1, t2;
+        real cap, dist;
+        double count[64] = { 0 }, chi = 0;
+        if (!visible_cap(&s, 0, p, n, &axis, &cap)) continue;
+        tangents(axis, &t1, &t2);
+        for (j = 0; j < m; j++) {
+            vec u;
+            real z, phi;
+            int cz, cp;
+            if (!(cap_sample(sp, axis, cap, p, (real)rnd(&x), (real)rnd(&x), &wi, &dist) > 0)) continue;
+            u = scale(1 / sp->rad, sub(comb(dist, wi, p), sp->cen));
+            z = dot(u, axis), phi = atan2(dot(u, t2), dot(u, t1));
+            cz = (int)((1 - z) / cap * N), cp = (int)((phi + PI) / (2 * PI) * N);
+            count[(cz < N ? cz : N - 1) * N + (cp < N ? cp : N - 1)]++;
+        }
+        for (a = 0; a < N; a++)
+            for (b = 0; b < N; b++) {
+                double share = 0, want;
+                int i, l;
+                for (i = 0; i < M; i++)
+                    for (l = 0; l < M; l++) {
+                        real z = 1 - cap * (a + (i + (real)0.5) / M) / N, phi = -PI + 2 * PI * (b + (l + (real)0.5) / M) / N;
+                        real q = sqrt(fmax(0, 1 - z * z));
+                        vec u = add(add(scale(q * cos(phi), t1), scale(q * sin(phi), t2)), scale(z, axis));
+                        vec y = comb(sp->rad, u, sp->cen), d = sub(y, p);
+                        real d2 = dot(d, d), cy = -dot(u, d) / sqrt(d2);
+                        if (cy > 0) share += cap_pdf(sp, axis, cap, p, y) * cy / d2;
+                    }
+                want = m * share * sp->rad * sp->rad * (cap / N) * (2 * PI / N) / (M * M);
+                chi += (count[a * N + b] - want) * (count[a * N + b] - want) / want;
+            }
+        if (chi > worst) worst = chi;
+    }
+    report(worst < 103.4, "clipped lamps: cap_sample's directions come as cap_pdf says (chi-square)",
+           "worst chi-square %.1f of 3 points, 64 cells, 63 degrees of freedom (fails above 103.4)", worst);
+    free_scene(&s);
+}
+
 static void test_clips(const char *file, const char *name, vec lo, vec hi)
 {
     Scene s;
@@ -566,6 +622,7 @@ int main(int argc, char **argv)
     test_pdf_agrees();
     test_clips("scenes/smallpt.sph", "smallpt.sph", v3(1, 0, 0), v3(99, 81.6, 170));
     test_cap_integral();
+    test_cap_chi_square();
     sprintf(file, "%.4000s/clips.sph", argc > 1 ? argv[1] : "/tmp");
     if (write_clips(file)) test_clips(file, "clips.sph", v3(-8, -8, -1), v3(8, 8, 7));
     else report(0, "clipped sphere lights", "cannot write %s", file);
