@@ -2972,9 +2972,10 @@ static void find_clips(Scene *s)
     if (!L->clip) out_of_memory();
     for (l = 0; l < L->nemit; l++) {
         Emitter *e = &L->emit[l];
-        const Sphere *sp = &s->sph[e->obj];     /* spheres are the first objects */
+        const Sphere *sp;
         e->clip = L->nclip, e->nclips = 0;
         if (e->type != SPHERE_LIGHT || moves(s, e->obj)) continue;
+        sp = &s->sph[e->obj];                   /* spheres are the first objects */
         for (j = 0; j < s->nsph; j++) {
             const Sphere *o = &s->sph[j];
             vec a = sub(o->cen, sp->cen);
@@ -3020,16 +3021,17 @@ static int clipped_lights(const Scene *s)
 static int visible_cap(const Scene *s, int l, vec x, vec n, vec *axis, real *cap)
 {
     const Emitter *e = &s->lights.emit[l];
-    const Sphere *sp = &s->sph[e->obj];
-    vec dx = sub(x, sp->cen);
-    real d2 = dot(dx, dx), best;
+    const Sphere *sp;
+    vec dx;
+    real d2, best;
     int i, found = 0;
     if (e->type != SPHERE_LIGHT || e->nclips == 0) return 0;
+    sp = &s->sph[e->obj];
+    dx = sub(x, sp->cen), d2 = dot(dx, dx);
     best = d2 > sp->rad * sp->rad * (1 + 64 * REAL_EPS) ? 1 - sp->rad / sqrt(d2) : 2;
-    for (i = e->clip; i < e->clip + e->nclips; i++) {
-        const Clip *c = &s->lights.clip[i];
+    for (i = e->clip; i < e->clip + e->nclips && clip_size(&s->lights.clip[i]) < best; i++) {
+        const Clip *c = &s->lights.clip[i];                 /* (smallest first: none after can do better) */
         const Sphere *o = &s->sph[c->obj];
-        if (clip_size(c) >= best) break;            /* neither cap smaller; nor any after it */
         vec dq = sub(x, o->cen);
         real out = dot(dq, dq) - o->rad * o->rad;          /* > 0 outside, about 2 rho times the distance */
         real band = 2048 * REAL_EPS * o->rad * (o->rad + maxabs(o->cen) + maxabs(x));
