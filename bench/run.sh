@@ -93,6 +93,9 @@
 #   skips   every skip and sampler at equal error: the time with it against
 #           the time without it at the same RMSE, one row per skip and
 #           scene (bench/skips.sh; plotted to skips.svg)
+#   threads one thread against two: the speed-up, how busy the threads
+#           were, and how much slower each ran beside the other
+#           (bench/threads.sh)
 # Embree and POV-Ray are instruments, not dependencies: when one is missing
 # its rows say "not installed, skipped".  BENCH_INSTALL=1 first tries
 # `apt-get install -y libembree-dev povray` for the missing ones.
@@ -103,10 +106,10 @@
 #   *.ppm       every render and the references, for a look at the error
 #   *.log       the raw output each table was read from
 #
-# Knobs (environment; with the defaults `make bench` takes about 9 minutes of
-# CPU on the 2-core development machine, 11 of wall clock beside other work;
-# 11 and 18 when it renders anew the references it keeps between runs):
-#   BENCH_PARTS="render spd build rays accel anim far pov pt dist adaptive skips"
+# Knobs (environment; with the defaults `make bench` takes about 10.5 minutes of
+# CPU on the 2-core development machine, 12 of wall clock beside other work;
+# 12.5 and 19 when it renders anew the references it keeps between runs):
+#   BENCH_PARTS="render spd build rays accel anim far pov pt dist adaptive skips threads"
 #   BENCH_FAR_RES=256 BENCH_FAR_N=65536   the far section's primary rays a side, and random rays
 #   BENCH_ROUNDS=3           rounds of turns between programs (ours and Embree
 #                            in the accel section, ours and POV-Ray, kd and
@@ -166,7 +169,7 @@ FLAKE_SIZE=${BENCH_FLAKE_SIZE:-}
 FLAKE_BUDGET=${BENCH_FLAKE_BUDGET:-150}
 MINRAY_SIZE=${BENCH_MINRAY_SIZE:-512x512}
 THREADS=${BENCH_THREADS:-}
-PARTS=${BENCH_PARTS:-render spd build rays accel anim far pov pt dist adaptive skips}
+PARTS=${BENCH_PARTS:-render spd build rays accel anim far pov pt dist adaptive skips threads}
 SPD_DIR=${BENCH_SPD_DIR:-scenes/spd}
 POV_DIR=${BENCH_POV_DIR:-../shared/spd/pov}
 SPD_SCENES=${BENCH_SPD:-balls_s4 gears_s4 mount_s6 rings_s7 teapot_s6 tetra_s6 tree_s11}
@@ -221,7 +224,7 @@ for n in $NONE_BUDGET $BUILD_MAX $RAYS_RES $RAYS_N $ROUNDS $RAYS_ROUNDS $FAR_RES
 done
 [ "$ROUNDS" -le 9 ] || die "BENCH_ROUNDS must be at most 9 (raybench anim's limit), not $ROUNDS"
 for p in $PARTS; do
-  case $p in render|spd|build|rays|accel|anim|far|pov|pt|dist|adaptive|skips) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim far pov pt dist adaptive skips)";; esac
+  case $p in render|spd|build|rays|accel|anim|far|pov|pt|dist|adaptive|skips|threads) ;; *) die "BENCH_PARTS: unknown section '$p' (render spd build rays accel anim far pov pt dist adaptive skips threads)";; esac
 done
 part() { [[ " $PARTS " == *" $1 "* ]]; }
 mkdir -p "$OUT" || die "cannot create $OUT"
@@ -1123,6 +1126,9 @@ part adaptive && own_script adaptive adaptive-sampling
 
 # ------------------------------------------------- every skip at equal error
 part skips && own_script skips every-skip
+
+# ------------------------------------------------- one thread against two
+part threads && own_script threads two-threads
 
 # ---------------------------------------------------------------- targets
 if [ ${#targets[@]} -gt 0 ]; then
