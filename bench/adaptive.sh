@@ -19,9 +19,6 @@ set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
 
-CC=${CC:-cc}
-CFLAGS=${CFLAGS:--O2}
-OUT=bench/out
 SCENES=${BENCH_ADAPTIVE_SCENES:-scenes/whitted.sph:320x240 scenes/spd/balls_s4.nff:256x256}
 REF_SPP=${BENCH_ADAPTIVE_REF_SPP:-256}
 RUNS=${BENCH_ADAPTIVE_RUNS:--n 16;-n 32 --adaptive 12;-n 64 --adaptive 16;-n 64 --adaptive 2;-n 64 --adaptive 0.5}

@@ -21,9 +21,6 @@ set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
 
-CC=${CC:-cc}
-CFLAGS=${CFLAGS:--O2}
-OUT=bench/out
 REF_SPP=${BENCH_DIST_REF_SPP:-1024}
 SPPS=${BENCH_DIST_SPP:-1 4 16 64}
 SCENES=${BENCH_DIST_SCENES:-dof:160x80 soft:160x120 glossy:160x80 motion:160x120}

@@ -1,4 +1,4 @@
-# bench/lib.sh - sourced by bench/run.sh, bench/pt.sh and bench/dist.sh: their names for
+# bench/lib.sh - sourced by bench/run.sh and the scripts of its parts: their names for
 # bench/table.c's subcommands (its top lists them all), built as $OUT/table.
 # kv LOG KEY: KEY's value in a log of ./ray --stats=kv ("key value" lines),
 # e.g. cpu_s, the render's CPU seconds (every thread; the scene's reading
@@ -10,6 +10,12 @@
 # verdict A OP B: "met" or "NOT MET".
 # die MESSAGE: the script's name and MESSAGE on stderr, exit 1; say: a
 # progress line.  And $OUT made, for the script that sources this.
+# The scripts' shared defaults (run.sh sets its own first): the compiler
+# and its flags as make passes them, and where everything is written.
+CC=${CC:-cc}
+CFLAGS=${CFLAGS:--O2}
+OUT=bench/out
+
 die() { echo "$0: $*" >&2; exit 1; }
 say() { echo "bench: $*" >&2; }
 mkdir -p "$OUT" || die "cannot create $OUT"

@@ -55,9 +55,6 @@ set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
 
-CC=${CC:-cc}
-CFLAGS=${CFLAGS:--O2}
-OUT=bench/out
 REF_SPP=${BENCH_PT_REF_SPP:-4096}
 SPPS=${BENCH_PT_SPP:-1 4 16 64 256}
 TOP=${BENCH_PT_TOP:-1024}

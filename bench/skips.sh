@@ -26,9 +26,6 @@ set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
 
-CC=${CC:-cc}
-CFLAGS=${CFLAGS:--O2}
-OUT=bench/out
 ROUNDS=${BENCH_ROUNDS:-3}
 REF_SPP=${BENCH_SKIPS_REF_SPP:-2048}
 WREF_SPP=${BENCH_SKIPS_WHITTED_REF_SPP:-256}

@@ -27,9 +27,6 @@ set -u -o pipefail
 export LC_ALL=C
 cd "$(dirname "$0")/.." || exit 2
 
-CC=${CC:-cc}
-CFLAGS=${CFLAGS:--O2}
-OUT=bench/out
 SCENES=${BENCH_THREADS_SCENES:-scenes/spd/balls_s4.nff:512x512:-n 4;scenes/spd/teapot_s6.nff:512x512:-n 4;scenes/cornell.sph:256x256:--pt -n 16;scenes/smallpt.sph:256x192:--pt -n 16}
 ROUNDS=${BENCH_ROUNDS:-5}
 [ "$ROUNDS" -ge 5 ] 2>/dev/null || ROUNDS=5
