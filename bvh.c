@@ -572,13 +572,17 @@ static void bounds_of(const bvh_builder *b, long first, long n, bvh_box *box,
  * small node's sweep then costs in proportion to it. */
 static int bins_for(long n) { return n < BINS ? (int)n : BINS; }
 
-/* The bin of doubled centroid c.  Compared before it is converted: a
+/* The bin of doubled centroid c.  Clamped before it is converted: a
  * centroid box thinner than a float step makes k1 infinite, and x infinite
- * or NaN (0 times infinity), which no int can hold. */
+ * or NaN (0 times infinity), which no int can hold.  The two clamps are
+ * written as a max and a min (a NaN fails the first and becomes 0) so that
+ * compilers make them two instructions, not two branches. */
 static int bin_of(float c, float lo, float k1, int nb)
 {
-    float x = (c - lo) * k1;
-    return !(x >= 1) ? 0 : x >= nb ? nb - 1 : (int)x;
+    float x = (c - lo) * k1, last = (float)(nb - 1);
+    x = x > 0 ? x : 0;
+    x = x < last ? x : last;
+    return (int)x;
 }
 
 /* nb slabs per axis of the centroid box: 1/width, or 0 for a flat axis
@@ -620,18 +624,22 @@ static double best_bin_split(const bvh_builder *b, long first, long n,
         double right_area[BINS];
         long right_n[BINS], nl = 0;
         if (k1[a] == 0) continue;
+        /* A plane just right of an empty bin parts the primitives as the
+         * plane before it does, at the same cost; the sweeps skip it (and
+         * an empty bin's box would add nothing). */
         box_empty(&acc);
         for (i = nb - 1, k = 0; i > 0; i--) {     /* right of plane i: bins i.. */
-            box_grow(&acc, &bin[a][i]);
-            k += count[a][i];
-            right_area[i] = box_area(&acc), right_n[i] = k;
+            if (count[a][i]) box_grow(&acc, &bin[a][i]), k += count[a][i];
+            right_n[i] = k;
+            if (count[a][i - 1]) right_area[i] = box_area(&acc);
         }
         box_empty(&acc);
         for (i = 1; i < nb; i++) {                /* plane i: bins 0..i-1 left */
             double cost;
+            if (!count[a][i - 1]) continue;
             box_grow(&acc, &bin[a][i - 1]);
             nl += count[a][i - 1];
-            if (nl == 0 || right_n[i] == 0) continue;
+            if (right_n[i] == 0) continue;
             cost = COST_STEP + COST_TEST * (box_area(&acc) * nl + right_area[i] * right_n[i]) / area;
             if (cost < best) best = cost, *axis = a, *split = i;
         }

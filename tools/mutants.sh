@@ -40,6 +40,8 @@
 #            choice's and the caps' images)
 #     kdbuild  tests/kdbuild.test.sh (the kd build's budget on fans, the
 #            ear clipper, what kdtree.c and bvh.c hold at their peaks)
+#     bvhbuild  tests/bvhbuild.test.sh (the BVH's binning and sweep against
+#            brute force)
 #
 # A test program that crashes or exits non-zero fails too (a FAIL line
 # says so).  The probe, for a mutant the tests let through: for pt,
@@ -74,6 +76,7 @@ tests_of() {
     photon) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/photons.test.sh >out 2>&1 || echo 'FAIL tests/photons.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     light) echo "make -s ray >/dev/null 2>&1 || exit 3; bash tests/light.test.sh >out 2>&1 || echo 'FAIL tests/light.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     kdbuild) echo "bash tests/kdbuild.test.sh >out 2>&1 || echo 'FAIL tests/kdbuild.test.sh exited' >>out; ! grep '^FAIL' out" ;;
+    bvhbuild) echo "bash tests/bvhbuild.test.sh >out 2>&1 || echo 'FAIL tests/bvhbuild.test.sh exited' >>out; ! grep '^FAIL' out" ;;
     bvh|grid)
       local structs=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
       echo "$build_accel; for a in $structs; do for s in $scenes; do
@@ -113,6 +116,7 @@ probe_of() {
                 ./ray --pt -t 1 -s 24x16 -n 4 --light-choice \$c -o p.pfm scenes/\$f.sph 2>/dev/null; echo \$f \$c; cksum <p.pfm;
               done; done" ;;
     kdbuild) echo "bash tests/kdbuild.test.sh 2>&1 | sed 's/[0-9][0-9.]* s\\b//'" ;;
+    bvhbuild) echo "bash tests/bvhbuild.test.sh 2>&1" ;;
     bvh|grid)
       local structs=$1 accel=$1; [ "$1" = bvh ] && structs='bvh-sah bvh-median'
       echo "$build_accel; for a in $structs; do for s in $scenes; do ACCEL_RAYS=50000 ./t \$a \$s 2>&1; done; done |
