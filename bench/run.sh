@@ -78,8 +78,9 @@
 #           rounds, structures and places taking turns; every 16th ray
 #           against the loop) (bench/raybench.c far; about 50 s)
 #   pov     SPD balls at 512x512, one thread: ./ray against --accel none and
-#           against POV-Ray 3.7; and POV-Ray's other SPD scenes; in rounds,
-#           taking turns
+#           against POV-Ray 3.7; and POV-Ray's other SPD scenes; ours with
+#           the kd-tree and with the default structure (--accel auto); in
+#           rounds, taking turns
 #   pt      the path tracer: each estimator's CPU time against its RMSE on the
 #           Cornell box and smallpt's scene, the estimators taking turns,
 #           against smallpt, and its rays per second against Whitted's
@@ -992,10 +993,12 @@ if part pov; then
     echo "whole: CPU seconds (user + system) of the whole run, scene to image; render: ours from --stats=kv, POV-Ray's trace"
     echo "time (its CPU-seconds); each the median of the rounds.  x whole, x render: POV-Ray's time over ours (above 1:"
     echo "ours is faster), the median of the rounds' ratios and (least-greatest).  rays: ours of every kind; POV-Ray's"
-    echo "rays plus its shadow ray tests."
+    echo "rays plus its shadow ray tests.  Ours with the kd-tree (--accel kd), and in the last columns with the default"
+    echo "structure (--accel auto: the scene's \`accel\` line, else the one a probe finds fastest; the build and the probe"
+    echo "counted): its whole run's CPU seconds, and POV-Ray's over it (issue 23's target: at least 3)."
     echo
-    printf '%-11s %-11s %7s %-13s %7s %7s %-13s %7s %7s %-11s %8s %-11s %9s %9s\n' pov nff "whole" "(range)" render \
-      "POV" "(range)" trace "x whole" "(range)" "x render" "(range)" "our rays" "POV rays"
+    printf '%-11s %-11s %7s %-13s %7s %7s %-13s %7s %7s %-11s %8s %-11s %9s %9s %7s %7s %-11s\n' pov nff "whole" "(range)" render \
+      "POV" "(range)" trace "x whole" "(range)" "x render" "(range)" "our rays" "POV rays" "auto" "x auto" "(range)"
   } | tee -a "$OUT/bench.txt"
   for pair in balls:balls_s4 rings:rings_s7 tree:tree_s11 teapot_s12:teapot_s12; do
     pov=${pair%%:*} nff=${pair#*:}
@@ -1012,11 +1015,17 @@ if part pov; then
     fi
     full_none=
     [ "$nff" = balls_s4 ] && [ "${BENCH_BALLS_NONE_FULL:-1}" = 1 ] && full_none=1
-    ours_w='' ours_r='' pov_w='' pov_t='' none_r='' ours_wall='' pov_wall='' ok=1
+    ours_w='' ours_r='' pov_w='' pov_t='' none_r='' ours_wall='' pov_wall='' auto_w='' ok=1
     for ((r = 1; r <= ROUNDS; r++)); do
       say "pov: $nff: ours at 512x512 (round $r)"
       if ! ray1 "$scene" 512x512 kd "$OUT/pov-ours-$nff.ppm" "$OUT/pov-ours-$nff.log"; then ok=; break; fi
       ours_w+="$took " ours_r+="$rsecs " ours_wall+="$wall "
+      say "pov: $nff: ours at 512x512, the default structure (round $r)"
+      if ! ray1 "$scene" 512x512 auto "$OUT/pov-auto-$nff.ppm" "$OUT/pov-auto-$nff.log"; then ok=; break; fi
+      auto_w+="$took "
+      if ! cmp -s "$OUT/pov-auto-$nff.ppm" "$OUT/pov-ours-$nff.ppm"; then
+        say "pov: $nff: the default structure's image differs from the kd-tree's"; ok=; break
+      fi
       if [ -n "$use_pov" ]; then
         say "pov: $pov: POV-Ray (round $r)"
         if pov1 "$src" "$PWD/$OUT/pov-$pov.ppm" "$OUT/pov-$pov.log" && num "$(pov_trace "$OUT/pov-$pov.log")"; then
@@ -1061,13 +1070,15 @@ if part pov; then
       targets+=("balls_s4 512x512, one thread: kd ${ku} us/ray, --accel none $none_us us/ray (measured at $none_size: CPU time per ray), speed-up ${sp}x (target >= 100x): $(verdict "$sp" ">=" 100)")
     fi
     if [ -n "$pov_w" ]; then
-      xw=$(ratios "$pov_w" "$ours_w") xr=$(ratios "$pov_t" "$ours_r")
+      xw=$(ratios "$pov_w" "$ours_w") xr=$(ratios "$pov_t" "$ours_r") xa=$(ratios "$pov_w" "$auto_w")
       pov_rays=$(pov_rays "$OUT/pov-$pov.log")
       # shellcheck disable=SC2086
-      printf '%-11s %-11s %7.3f %-13s %7.3f %7.3f %-13s %7.3f %7.2f %-11s %8.2f %-11s %9s %9s\n' "$pov" "$nff" "$m_ow" \
+      printf '%-11s %-11s %7.3f %-13s %7.3f %7.3f %-13s %7.3f %7.2f %-11s %8.2f %-11s %9s %9s %7.3f %7.2f %-11s\n' "$pov" "$nff" "$m_ow" \
         "($(range %.3f $ours_w))" "$m_or" "$(median $pov_w)" "($(range %.3f $pov_w))" "$(median $pov_t)" \
-        "$(median $xw)" "($(range %.2f $xw))" "$(median $xr)" "($(range %.2f $xr))" "$ours_rays" "${pov_rays:--}" |
-        tee -a "$OUT/bench.txt"
+        "$(median $xw)" "($(range %.2f $xw))" "$(median $xr)" "($(range %.2f $xr))" "$ours_rays" "${pov_rays:--}" \
+        "$(median $auto_w)" "$(median $xa)" "($(range %.2f $xa))" | tee -a "$OUT/bench.txt"
+      # shellcheck disable=SC2086
+      targets+=("$nff 512x512, one thread, CPU of whole runs with the default structure (--accel auto), median of $ROUNDS rounds taking turns: ours $(printf %.3f "$(median $auto_w)") s, POV-Ray 3.7 $(printf %.3f "$(median $pov_w)") s, POV-Ray over ours $(printf %.2f "$(median $xa)") ($(range %.2f $xa)) (target >= 3, issue 23): $(verdict "$(median $xa)" ">=" 3)")
       q=$(ratios "$pov_wall" "$ours_wall")
       # shellcheck disable=SC2086
       walls+=("$(printf '%-11s ours %.3f s, POV-Ray %.3f s: %.2fx' "$pov" "$(median $ours_wall)" "$(median $pov_wall)" \
