@@ -603,22 +603,22 @@ static double best_bin_split(const bvh_builder *b, long first, long n,
 {
     bvh_box bin[3][BINS], acc;
     long count[3][BINS], k;
-    float k1[3];
+    float k1[4] = { 0, 0, 0, 0 }, lo[4] = { 0, 0, 0, 0 };  /* lane 3 (a copy of 2) to bin 0, unused */
     double best = HUGE_VAL;
     int a, i, nb = bins_for(n);
     for (a = 0; a < 3; a++) {
-        k1[a] = bin_scale(cbox, a, nb);
+        k1[a] = bin_scale(cbox, a, nb), lo[a] = cbox->lo[a];
         for (i = 0; i < nb; i++) box_empty(&bin[a][i]), count[a][i] = 0;
     }
     for (k = first; k < first + n; k++) {
-        const bvh_ref *r = &b->ref[k];
         bvh_box rb;
-        ref_box(r, &rb);
-        for (a = 0; a < 3; a++) {
-            int j = bin_of(centroid2(r, a), cbox->lo[a], k1[a], nb);
-            box_grow(&bin[a][j], &rb);
-            count[a][j]++;
-        }
+        int j[4];
+        ref_box(&b->ref[k], &rb);
+        for (a = 0; a < 4; a++)   /* all axes at once: a loop compilers vectorise */
+            j[a] = bin_of(rb.lo[a] + rb.hi[a], lo[a], k1[a], nb);
+        box_grow(&bin[0][j[0]], &rb), count[0][j[0]]++;
+        box_grow(&bin[1][j[1]], &rb), count[1][j[1]]++;
+        box_grow(&bin[2][j[2]], &rb), count[2][j[2]]++;
     }
     for (a = 0; a < 3; a++) {
         double right_area[BINS];

@@ -469,13 +469,17 @@ static real maxabs(vec a)
     return m;
 }
 
-/* Grows [lo, hi] to take in [lo2, hi2]. */
+/* Grows [lo, hi] to take in [lo2, hi2].  Written out, not as fmin and
+ * fmax: the builds call it for every triangle, and those are library calls
+ * on most targets.  On numbers the two agree, with glibc's
+ * choice of the first when neither is smaller (+0 and -0); no NaN reaches
+ * here (the readers take finite numbers only). */
 static void box_union(double lo[3], double hi[3], const double lo2[3], const double hi2[3])
 {
     int a;
     for (a = 0; a < 3; a++) {
-        lo[a] = fmin(lo[a], lo2[a]);
-        hi[a] = fmax(hi[a], hi2[a]);
+        lo[a] = lo2[a] < lo[a] ? lo2[a] : lo[a];
+        hi[a] = hi2[a] > hi[a] ? hi2[a] : hi[a];
     }
 }
 
