@@ -10,7 +10,8 @@
  *           each plane by a loop over every record: the same best cost,
  *           bit for bit, at the same axis and plane (the first such, axis
  *           by axis, plane by plane, as a strict "<" keeps it).  On record
- *           sets of 1 to 40 and of 100 and 1000, scattered, in clusters
+ *           sets of 1 to 40 and of 100 and 1000, and 40 more pairs (two
+ *           records take a path of their own), scattered, in clusters
  *           (many empty bins), in few distinct places (ties), and flat
  *           along an axis.
  */
@@ -113,11 +114,11 @@ static void check_sweep(void)
     memset(&b, 0, sizeof b);
     b.ref = r;
     for (kind = 0; kind < 4; kind++)
-        for (s = 0; s < 42; s++) {
+        for (s = 0; s < 82; s++) {
             bvh_box box, cbox;
             double fast, slow;
             int fa = -1, fs = -1, sa = -1, ss = -1;
-            n = s < 40 ? s + 1 : sizes[s - 40];
+            n = s < 40 ? s + 1 : s < 42 ? sizes[s - 40] : 2;   /* and 40 more pairs */
             make_refs(r, n, kind);
             bounds_of(&b, 0, n, &box, &cbox);
             fast = best_bin_split(&b, 0, n, &cbox, box_area(&box), &fa, &fs);
