@@ -548,7 +548,7 @@ static void ref_box(const bvh_ref *r, bvh_box *b)
     b->hi[0] = r->hi[0], b->hi[1] = r->hi[1], b->hi[2] = b->hi[3] = r->hi[2];
 }
 
-static void grow_ref(bvh_box *box, bvh_box *cbox, const bvh_ref *r)
+static inline void grow_ref(bvh_box *box, bvh_box *cbox, const bvh_ref *r)
 {
     bvh_box rb, c;
     int a;
