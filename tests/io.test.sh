@@ -48,8 +48,9 @@ cmp -s "$TMP/got" "$TMP/want" && ok "--gamma gives the sRGB curve's bytes, linea
 # points, CRC-32 and Adler-32 check values, extensions, and paths split as
 # POSIX and (-DRAY_DOS_PATHS) as Windows splits them.
 for paths in "" -DRAY_DOS_PATHS; do
-  # shellcheck disable=SC2046 # the parts but image.c, which test_io.c includes
-  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c $(echo " $RAY_PARTS " | sed "s/ image.c / /") -lm 2> "$TMP/err"; then
+  # shellcheck disable=SC2046 # the parts but image.c, which test_io.c
+  # includes, and scene.c, which splits the paths
+  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c scene.c $(parts_but image scene) -lm 2> "$TMP/err"; then
     "$TMP/test_io"
   else
     bad "tests/test_io.c $paths compiles: $(head -3 "$TMP/err")"

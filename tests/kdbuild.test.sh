@@ -8,7 +8,7 @@ counted="-Dmalloc=kdb_malloc -Dcalloc=kdb_calloc -Drealloc=kdb_realloc -Dfree=kd
 # shellcheck disable=SC2086
 if ! $CC $CFLAGS $counted -c kdtree.c -o "$TMP/kd_counted.o" 2>"$TMP/cc.err" \
    || ! $CC $CFLAGS $counted -c bvh.c -o "$TMP/bvh_counted.o" 2>>"$TMP/cc.err" \
-   || ! $CC $CFLAGS -o "$TMP/test_kdbuild" tests/test_kdbuild.c "$TMP/kd_counted.o" "$TMP/bvh_counted.o" $(echo " $RAY_PARTS " | sed "s/ kdtree.c / /; s/ bvh.c / /") -lm 2>>"$TMP/cc.err"; then
+   || ! $CC $CFLAGS -o "$TMP/test_kdbuild" tests/test_kdbuild.c "$TMP/kd_counted.o" "$TMP/bvh_counted.o" $(parts_but kdtree bvh) -lm 2>>"$TMP/cc.err"; then
   bad "test_kdbuild builds: $(head -c 300 "$TMP/cc.err" | tr '\n' ' ')"
   exit 1
 fi

@@ -10,7 +10,18 @@ CC=${CC:-cc}
 CFLAGS=${CFLAGS:--O2}
 # What a program that includes ray.c whole links beside it (the Makefile's
 # RAY_PARTS); word-split on purpose where it is used.
+# tests/run.sh compiles them once and passes their objects (*.o) instead.
 RAY_PARTS=${RAY_PARTS:-scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c}
+# RAY_PARTS but the parts named (scene image ...): for a build that compiles
+# those itself (with a -D of its own) or includes them.
+parts_but() {
+  local p n keep=
+  for p in $RAY_PARTS; do
+    n=${p##*/}; n=${n%.[co]}
+    case " $* " in *" $n "*) ;; *) keep="$keep $p";; esac
+  done
+  echo "$keep"
+}
 export TMP=$(mktemp -d "${TMPDIR:-/tmp}/raytest.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
 # Python that reads a PFM's floats, for the tests' checkers: pfm(name) is

@@ -13,6 +13,22 @@ cd "$(dirname "$0")/.." || exit 2
 jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 out=$(mktemp -d "${TMPDIR:-/tmp}/testrun.XXXXXX")
 trap 'rm -rf "$out"' EXIT
+# The parts every test program links beside ray.c (RAY_PARTS: scene.c,
+# image.c, ...) are compiled here once, not once a program; if one does
+# not compile, the scripts get the sources and say so themselves.
+CC=${CC:-cc} CFLAGS=${CFLAGS:--O2}
+parts=${RAY_PARTS:-$(bash -c '. tests/lib.sh; echo $RAY_PARTS')}
+mkdir "$out/parts"
+objs='' pids=''
+for c in $parts; do
+  o=$out/parts/$(basename "${c%.c}").o
+  # shellcheck disable=SC2086 # CFLAGS holds several words
+  $CC $CFLAGS -std=c99 -c -o "$o" "$c" 2>/dev/null &
+  objs="$objs $o" pids="$pids $!"
+done
+built=1
+for p in $pids; do wait "$p" || built=0; done
+[ $built = 1 ] && export RAY_PARTS="${objs# }"
 longest_first="tests/photons.test.sh tests/pt.test.sh tests/ray.test.sh tests/accel.test.sh tests/bdpt.test.sh tests/light.test.sh tests/kdbuild.test.sh tests/split.test.sh tests/motion.test.sh tests/sampler.test.sh tests/dist.test.sh tests/io.test.sh tests/hooks.test.sh tests/golf.test.sh"
 scripts=$longest_first
 for t in tests/*.test.sh; do

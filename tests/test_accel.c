@@ -136,9 +136,11 @@ static void random_dir(double d[3])
 
 /* ---- the primitives and their callbacks -------------------------------- */
 
-static double maxabs3(const double a[3])
+static double maxabs3(const double a[3])   /* no NaN here: fmax's answer, without its call */
 {
-    return fmax(fabs(a[0]), fmax(fabs(a[1]), fabs(a[2])));
+    double x = fabs(a[0]), y = fabs(a[1]), z = fabs(a[2]);
+    x = y > x ? y : x;
+    return z > x ? z : x;
 }
 
 /* Triangle: the three edge tests share their products with the neighbour

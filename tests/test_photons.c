@@ -5,7 +5,6 @@
  * and the points within a radius are brute force's, each once.  Fixed
  * seeds. */
 #include <stdio.h>
-#include <stdlib.h>
 #include "../photons.h"
 #include "report.h"
 
@@ -26,17 +25,25 @@ static void visit(void *user, int i, float d2)
     v->wrong += d2 != e0 * e0 + e1 * e1 + e2 * e2;
 }
 
-static int cmp(const void *a, const void *b)
+/* Brute force's k nearest: d joins the k smallest distances seen so far,
+ * kept nearest first in near[0..*kept), if it is smaller than the last. */
+static void keep_nearest(float *near, int *kept, int k, float d)
 {
-    float x = *(const float *)a, y = *(const float *)b;
-    return x < y ? -1 : x > y;
+    int j;
+    if (*kept == k) {
+        if (!(d < near[k - 1])) return;     /* no nearer than the k kept */
+        j = k - 1;                          /* the farthest kept gives way */
+    } else
+        j = (*kept)++;
+    for (; j > 0 && d < near[j - 1]; j--) near[j] = near[j - 1];
+    near[j] = d;
 }
 
 int main(void)
 {
     static const char *const kinds[] = { "uniform", "clustered", "coplanar", "repeated" };
     enum { N = 20000, Q = 2000, K = 50 };
-    static float p[N][3], all[N], d2[K];
+    static float p[N][3], near[K], d2[K];
     static int idx[K], seen[N];
     unsigned long long s = 7;
     int kind;
@@ -52,12 +59,12 @@ int main(void)
         if (!point_tree_build(&t, (const float (*)[3])p, n)) { report(0, "build", "out of memory"); return 1; }
         for (q = 0; q < Q; q++) {
             float x[3], r2 = q % 3 == 0 ? 1e30f : 0.01f * (1 + q % 10);
-            int k = 1 + q % K, found, want = 0, j;
+            int k = 1 + q % K, found, want = 0, kept = 0, j;
             x[0] = (kind == 1 ? 7 : 1.2f) * rnd(&s) - 0.1f, x[1] = rnd(&s), x[2] = rnd(&s);
             found = point_tree_nearest(&t, x, k, r2, idx, d2);
             for (i = 0; i < n; i++) {
                 float e0 = x[0] - p[i][0], e1 = x[1] - p[i][1], e2 = x[2] - p[i][2], d = e0 * e0 + e1 * e1 + e2 * e2;
-                if (d < r2) all[want++] = d;
+                if (d < r2) want++, keep_nearest(near, &kept, k, d);
             }
             if (r2 < 1) {                       /* every point within the radius, once */
                 Visits v;
@@ -72,13 +79,12 @@ int main(void)
                 inside += got;
                 bad_within += v.wrong || got != want;
             }
-            qsort(all, (size_t)want, sizeof *all, cmp);
             if (want > k) want = k;
             total += found;
             if (found != want) { bad++; continue; }
             for (j = 0; j < found; j++) {
                 float e0 = x[0] - p[idx[j]][0], e1 = x[1] - p[idx[j]][1], e2 = x[2] - p[idx[j]][2];
-                if (d2[j] != all[j] || d2[j] != e0 * e0 + e1 * e1 + e2 * e2) { bad++; break; }
+                if (d2[j] != near[j] || d2[j] != e0 * e0 + e1 * e1 + e2 * e2) { bad++; break; }
             }
         }
         sprintf(name, "the photon tree's k nearest, %s points, are brute force's", kinds[kind]);
