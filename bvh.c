@@ -602,6 +602,7 @@ static double split_two(const bvh_builder *b, long first, const bvh_box *cbox,
 {
     const bvh_ref *r = &b->ref[first];
     bvh_box left, right;
+    double cost;
     int a;
     for (a = 0; a < 3; a++)
         if (bin_scale(cbox, a, 2) != 0) break;
@@ -609,7 +610,8 @@ static double split_two(const bvh_builder *b, long first, const bvh_box *cbox,
     ref_box(&r[centroid2(&r[0], a) > centroid2(&r[1], a)], &left);
     ref_box(&r[centroid2(&r[0], a) <= centroid2(&r[1], a)], &right);
     *axis = a, *split = 1;
-    return COST_STEP + COST_TEST * (box_area(&left) * 1 + box_area(&right) * 1) / area;
+    cost = COST_STEP + COST_TEST * (box_area(&left) * 1 + box_area(&right) * 1) / area;
+    return cost < HUGE_VAL ? cost : HUGE_VAL;   /* a node of no area: no plane */
 }
 
 /* Wald 2007: one pass puts every primitive in a bin on each axis; then a
@@ -623,7 +625,7 @@ static double best_bin_split(const bvh_builder *b, long first, long n,
     bvh_box bin[3][BINS], acc;
     long count[3][BINS], k;
     float k1[4] = { 0, 0, 0, 0 }, lo[4] = { 0, 0, 0, 0 };  /* lane 3 (a copy of 2) to bin 0, unused */
-    double best = HUGE_VAL;
+    double best = HUGE_VAL, cost;   /* best: the least area-weighted count; the cost, once */
     int a, i, nb = bins_for(n);
     if (n == 2) return split_two(b, first, cbox, area, axis, split);
     for (a = 0; a < 3; a++) {
@@ -655,16 +657,17 @@ static double best_bin_split(const bvh_builder *b, long first, long n,
         }
         box_empty(&acc);
         for (i = 1; i < nb; i++) {                /* plane i: bins 0..i-1 left */
-            double cost;
+            double sum;
             if (!count[a][i - 1]) continue;
             box_grow(&acc, &bin[a][i - 1]);
             nl += count[a][i - 1];
             if (right_n[i] == 0) continue;
-            cost = COST_STEP + COST_TEST * (box_area(&acc) * nl + right_area[i] * right_n[i]) / area;
-            if (cost < best) best = cost, *axis = a, *split = i;
+            sum = box_area(&acc) * nl + right_area[i] * right_n[i];
+            if (sum < best) best = sum, *axis = a, *split = i;
         }
     }
-    return best;
+    cost = COST_STEP + COST_TEST * best / area;
+    return cost < HUGE_VAL ? cost : HUGE_VAL;   /* NaN, a node of no area: no plane */
 }
 
 /* The two sides of a split: their boxes and centroid boxes. */
