@@ -49,8 +49,8 @@ cmp -s "$TMP/got" "$TMP/want" && ok "--gamma gives the sRGB curve's bytes, linea
 # POSIX and (-DRAY_DOS_PATHS) as Windows splits them.
 for paths in "" -DRAY_DOS_PATHS; do
   # shellcheck disable=SC2046 # the parts but image.c, which test_io.c
-  # includes, and scene.c, which splits the paths
-  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c scene.c $(parts_but image scene) -lm 2> "$TMP/err"; then
+  # includes, from their sources (-O0, without CFLAGS)
+  if $CC -std=c99 -O0 $paths -o "$TMP/test_io" tests/test_io.c $(RAY_PARTS=$RAY_SOURCES parts_but image) -lm 2> "$TMP/err"; then
     "$TMP/test_io"
   else
     bad "tests/test_io.c $paths compiles: $(head -3 "$TMP/err")"
@@ -194,7 +194,7 @@ done
 [ $rc = 0 ] && grep -qE "^ray [0-9]+\.[0-9]+" "$TMP/out.txt" && ok "--version: $(cat "$TMP/out.txt")" \
   || bad "--version: exit $rc, $(cat "$TMP/out.txt")"
 # -t without OpenMP: one warning however often -t is given; with it, none.
-if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c $RAY_PARTS -lm 2> "$TMP/err"; then
+if $CC -std=c99 -O0 -o "$TMP/ray_serial" ray.c $RAY_SOURCES -lm 2> "$TMP/err"; then
   "$TMP/ray_serial" -t 2 -t 3 -s 4x4 -o "$TMP/t.ppm" scenes/whitted.sph 2> "$TMP/err"
   [ "$(grep -c "warning: -t 3 is ignored" "$TMP/err")" = 1 ] && [ "$(wc -l < "$TMP/err")" = 1 ] \
     && ok "-t without OpenMP warns once: $(cat "$TMP/err")" || bad "-t without OpenMP: $(cat "$TMP/err")"

@@ -10,8 +10,11 @@ CC=${CC:-cc}
 CFLAGS=${CFLAGS:--O2}
 # What a program that includes ray.c whole links beside it (the Makefile's
 # RAY_PARTS); word-split on purpose where it is used.
-# tests/run.sh compiles them once and passes their objects (*.o) instead.
+# tests/run.sh compiles them once and passes their objects (*.o) instead,
+# compiled with CC and CFLAGS; RAY_SOURCES keeps the sources, for a build
+# with flags of its own.
 RAY_PARTS=${RAY_PARTS:-scene.c image.c cli.c kdtree.c bvh.c grid.c photons.c}
+RAY_SOURCES=${RAY_SOURCES:-$RAY_PARTS}
 # RAY_PARTS but the parts named (scene image ...): for a build that compiles
 # those itself (with a -D of its own) or includes them.
 parts_but() {

@@ -28,6 +28,7 @@ for c in $parts; do
 done
 built=1
 for p in $pids; do wait "$p" || built=0; done
+export RAY_SOURCES="$parts"
 [ $built = 1 ] && export RAY_PARTS="${objs# }"
 longest_first="tests/photons.test.sh tests/pt.test.sh tests/ray.test.sh tests/accel.test.sh tests/bdpt.test.sh tests/light.test.sh tests/kdbuild.test.sh tests/split.test.sh tests/motion.test.sh tests/sampler.test.sh tests/dist.test.sh tests/io.test.sh tests/hooks.test.sh tests/golf.test.sh"
 scripts=$longest_first
